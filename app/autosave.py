@@ -1,0 +1,170 @@
+"""Autosave and crash recovery.  Pure Python: no Qt here.
+
+Each running window owns one `AutosaveManager`.  `save` writes the document
+to ``<session>.json`` in the autosave folder and a small sidecar
+``<session>.meta.json`` naming the project it belongs to, the time and the
+process id.  A clean save or a clean exit calls `clear`, which removes both.
+Files that survive belong to a process that died: `find_recoverable` lists
+those whose process is gone and which are newer than their original project
+file, so the next start can offer to recover them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+
+from engine.graph import GraphDocument, document_to_dict, load_project, write_atomic
+
+ENV_VAR = "MESOFORGE_AUTOSAVE_DIR"
+META_SUFFIX = ".meta.json"
+DOC_SUFFIX = ".json"
+
+
+def default_autosave_dir() -> Path:
+    """``$MESOFORGE_AUTOSAVE_DIR`` if set, else ``~/.local/share/mesoforge/autosave``."""
+    env = os.environ.get(ENV_VAR)
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_DATA_HOME") or os.path.join(os.path.expanduser("~"), ".local", "share")
+    return Path(base) / "mesoforge" / "autosave"
+
+
+def pid_alive(pid: int) -> bool:
+    """Whether a process with this id is running (on this machine)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    except OSError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class RecoveryItem:
+    """An autosave left behind by a process that is no longer running.
+
+    original_path : the project file it was autosaved for, or None (untitled).
+    saved_at : seconds since the epoch when the autosave was written.
+    """
+
+    autosave_path: Path
+    meta_path: Path
+    original_path: str | None
+    saved_at: float
+    pid: int
+
+    @property
+    def display_name(self) -> str:
+        return Path(self.original_path).name if self.original_path else "untitled project"
+
+
+class AutosaveManager:
+    """Writes, clears and finds autosaves of one session.
+
+    Parameters
+    ----------
+    directory : folder for autosaves; default `default_autosave_dir()`.
+    pid : process id recorded in the sidecar (tests may pass a dead one).
+    """
+
+    def __init__(self, directory: str | os.PathLike | None = None, *, pid: int | None = None):
+        self.directory = Path(directory) if directory is not None else default_autosave_dir()
+        self.pid = os.getpid() if pid is None else int(pid)
+        self.session = f"autosave-{self.pid}-{uuid.uuid4().hex[:8]}"
+        self.last_saved_at: float | None = None
+
+    @property
+    def autosave_path(self) -> Path:
+        return self.directory / f"{self.session}{DOC_SUFFIX}"
+
+    @property
+    def meta_path(self) -> Path:
+        return self.directory / f"{self.session}{META_SUFFIX}"
+
+    def save(self, doc: GraphDocument, project_path: str | os.PathLike | None) -> Path:
+        """Write `doc` atomically (document first, then its sidecar)."""
+        text = json.dumps(document_to_dict(doc), indent=1, allow_nan=False)
+        write_atomic(self.autosave_path, (text + "\n").encode("utf-8"))
+        now = time.time()
+        meta = {
+            "original_path": None if project_path is None else str(Path(project_path).resolve()),
+            "saved_at": now,
+            "pid": self.pid,
+            "autosave": self.autosave_path.name,
+        }
+        write_atomic(self.meta_path, (json.dumps(meta, indent=1) + "\n").encode("utf-8"))
+        self.last_saved_at = now
+        return self.autosave_path
+
+    def clear(self) -> None:
+        """Remove this session's autosave (after a clean save or exit)."""
+        for p in (self.meta_path, self.autosave_path):
+            try:
+                p.unlink()
+            except FileNotFoundError:
+                pass
+        self.last_saved_at = None
+
+    # -- recovery ---------------------------------------------------------
+    def find_recoverable(self) -> list[RecoveryItem]:
+        """Autosaves of dead processes that are newer than their original file, newest first."""
+        if not self.directory.is_dir():
+            return []
+        items = []
+        for meta_path in sorted(self.directory.glob(f"*{META_SUFFIX}")):
+            item = _read_meta(meta_path)
+            if item is None or item.meta_path == self.meta_path or pid_alive(item.pid):
+                continue
+            if not item.autosave_path.is_file():
+                continue
+            if item.original_path is not None:
+                try:
+                    if os.path.getmtime(item.original_path) >= item.saved_at:
+                        continue  # the project was saved after this autosave: nothing to recover
+                except OSError:
+                    pass  # the original is gone: the autosave is all there is
+            items.append(item)
+        items.sort(key=lambda it: it.saved_at, reverse=True)
+        return items
+
+    @staticmethod
+    def load(item: RecoveryItem) -> GraphDocument:
+        """The autosaved document; raises ProjectFileError if it is unreadable."""
+        return load_project(item.autosave_path)
+
+    @staticmethod
+    def discard(item: RecoveryItem) -> None:
+        for p in (item.meta_path, item.autosave_path):
+            try:
+                p.unlink()
+            except FileNotFoundError:
+                pass
+
+
+def _read_meta(meta_path: Path) -> RecoveryItem | None:
+    """Parse a sidecar; None when it is unreadable or malformed (it is skipped)."""
+    try:
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        name = meta["autosave"]
+        if not isinstance(name, str) or "/" in name or "\\" in name:
+            return None
+        original = meta.get("original_path")
+        return RecoveryItem(
+            autosave_path=meta_path.parent / name,
+            meta_path=meta_path,
+            original_path=str(original) if original is not None else None,
+            saved_at=float(meta["saved_at"]),
+            pid=int(meta["pid"]),
+        )
+    except (OSError, ValueError, KeyError, TypeError):
+        return None

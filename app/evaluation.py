@@ -1,0 +1,92 @@
+"""Headless evaluation of a project for the command line: summary + mesh export."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from engine.graph import EvalReport, Evaluator, GraphDocument, SetParam, UndoStack
+from engine.graph.values import Solid, VoxelModel
+
+
+def result_node(doc: GraphDocument, report: EvalReport, node_id: str | None = None) -> str | None:
+    """The node whose solid is "the result": the given one, else the one feeding the
+    Voxel node, else the last Solid-producing node in topological order."""
+    if node_id is not None:
+        if node_id not in doc.nodes:
+            raise ValueError(f"--node: no node with id {node_id!r} (nodes: {', '.join(doc.nodes)})")
+        return node_id
+    for nid, node in doc.nodes.items():
+        if node.type_name == "Voxel":
+            src = doc.inputs_of(nid, "solid")
+            if src:
+                return src[0].src
+    solids = [n for n in doc.topological_order() if isinstance(_first_output(report, n), (Solid, VoxelModel))]
+    return solids[-1] if solids else None
+
+
+def _first_output(report: EvalReport, nid: str) -> Any:
+    outs = report.outputs.get(nid) or {}
+    return next(iter(outs.values()), None)
+
+
+def solid_of(report: EvalReport, nid: str) -> Solid | None:
+    v = _first_output(report, nid)
+    if isinstance(v, VoxelModel):
+        return v.solid
+    return v if isinstance(v, Solid) else None
+
+
+def override_resolution(doc: GraphDocument, resolution: int) -> None:
+    """Set every Object node's grid resolution (quick previews / studies)."""
+    stack = UndoStack(doc)
+    for nid, node in doc.nodes.items():
+        if node.type_name == "Object":
+            stack.push(SetParam(nid, "resolution", resolution))
+
+
+@dataclass
+class MeshResult:
+    vertices: np.ndarray
+    faces: np.ndarray
+    summary: dict
+
+
+def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
+    from engine.geometry.marching import periodic_mesh
+    from engine.geometry.mesh_io import mesh_summary
+
+    tiles = tuple(int(t) for t in tiles)
+    if tiles == (1, 1, 1):
+        v, f = np.asarray(solid.vertices), np.asarray(solid.faces)
+    else:
+        v, f = periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size)
+    s = mesh_summary(v, f)
+    s["volume_fraction"] = float(s["volume"]) / (solid.cell_size ** 3 * np.prod(tiles))
+    s["grid_volume_fraction"] = solid.volume_fraction
+    s["tiles"] = list(tiles)
+    return MeshResult(v, f, s)
+
+
+def report_json(doc: GraphDocument, report: EvalReport) -> dict:
+    nodes = []
+    for nid in doc.topological_order():
+        r = report.results.get(nid)
+        if r is None:
+            continue
+        entry = {"id": nid, "type": doc.nodes[nid].type_name, "status": r.status,
+                 "seconds": round(r.seconds, 6)}
+        if r.error:
+            entry["error"] = r.error
+            if r.where:
+                entry["where"] = r.where
+        nodes.append(entry)
+    return {"ok": report.ok, "seconds": round(report.seconds, 6), "cache_hits": report.cache_hits,
+            "evaluated": sum(r.status == "evaluated" for r in report.results.values()),
+            "failed": sorted(report.errors), "nodes": nodes}
+
+
+def evaluate_document(doc: GraphDocument, *, on_progress=None) -> EvalReport:
+    return Evaluator().evaluate(doc, on_progress=on_progress)

@@ -1,0 +1,43 @@
+"""Errors raised at the graph boundary.  Each names what was wrong."""
+
+from __future__ import annotations
+
+
+class GraphError(ValueError):
+    """A refused edit or evaluation; `node` and `where` locate it."""
+
+    def __init__(self, message: str, *, node: str | None = None, where: str | None = None):
+        super().__init__(message)
+        self.node = node
+        self.where = where
+
+
+class ParamError(GraphError):
+    """A parameter value outside its schema."""
+
+    def __init__(self, name: str, value, expected: str, *, node: str | None = None):
+        self.param = name
+        self.value = value
+        self.expected = expected
+        prefix = f"node {node!r}: " if node else ""
+        super().__init__(
+            f"{prefix}parameter {name!r} = {value!r} is invalid: expected {expected}",
+            node=node,
+            where=name,
+        )
+
+    def on_node(self, node: str) -> "ParamError":
+        return ParamError(self.param, self.value, self.expected, node=node)
+
+
+class NodeInputError(GraphError):
+    """Raised by a node's evaluate when its inputs do not meet its requirements."""
+
+
+class ProjectFileError(ValueError):
+    """A project file that cannot be opened; names the path and the reason."""
+
+    def __init__(self, path, reason: str):
+        super().__init__(f"cannot open project {str(path)!r}: {reason}")
+        self.path = str(path)
+        self.reason = reason

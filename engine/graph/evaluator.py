@@ -1,0 +1,206 @@
+"""Incremental evaluation of a graph snapshot.
+
+Each node's outputs are cached under a key made of its type name and version,
+its canonical parameters, the node seed (for random nodes) and the keys of
+its inputs in connection order.  Editing one parameter changes the key of
+that node and of everything downstream, and nothing else, so only those
+re-run.  A failing node records its error; nodes below it are blocked; caches
+above it stay.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import threading
+import time
+from collections import OrderedDict
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from .document import GraphDocument, GraphSnapshot, topological_order
+from .errors import GraphError
+from .node import Cancelled, CancelToken, EvalContext, node_type
+
+# Node statuses in a report.
+EVALUATED, CACHED, FAILED, BLOCKED, CANCELLED = "evaluated", "cached", "failed", "blocked", "cancelled"
+
+
+@dataclass
+class NodeResult:
+    node_id: str
+    status: str
+    seconds: float = 0.0
+    error: str = ""
+    where: str = ""
+    key: str = ""
+
+
+@dataclass
+class EvalReport:
+    results: dict[str, NodeResult] = field(default_factory=dict)
+    outputs: dict[str, dict[str, Any]] = field(default_factory=dict)
+    seconds: float = 0.0
+    cancelled: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return not self.cancelled and all(r.status in (EVALUATED, CACHED) for r in self.results.values())
+
+    @property
+    def cache_hits(self) -> int:
+        return sum(r.status == CACHED for r in self.results.values())
+
+    @property
+    def errors(self) -> dict[str, str]:
+        return {n: r.error for n, r in self.results.items() if r.status == FAILED}
+
+    def output(self, node_id: str, port: str | None = None) -> Any:
+        outs = self.outputs[node_id]
+        if port is None:
+            (port,) = outs.keys() if len(outs) == 1 else (next(iter(outs)),)
+        return outs[port]
+
+
+def _canonical(obj: Any) -> str:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def check_required_inputs(snapshot: GraphSnapshot, node_id: str) -> None:
+    type_name, _ = snapshot.nodes[node_id]
+    cls = node_type(type_name)
+    for port in cls.inputs:
+        if port.required and not snapshot.inputs_of(node_id, port.name):
+            raise GraphError(f"node {node_id!r} ({type_name}): required input {port.name!r} "
+                             f"({port.type}) is not connected", node=node_id, where=port.name)
+
+
+class Evaluator:
+    """Evaluates snapshots, reusing cached outputs across calls.
+
+    One evaluation at a time (a lock serialises calls); the cache holds at
+    most `max_entries` node results, least recently used dropped first.
+    """
+
+    def __init__(self, max_entries: int = 512):
+        self._cache: OrderedDict[str, dict[str, Any]] = OrderedDict()
+        self.max_entries = max_entries
+        self._lock = threading.Lock()
+
+    def clear(self) -> None:
+        with self._lock:
+            self._cache.clear()
+
+    def _cache_get(self, key: str):
+        v = self._cache.get(key)
+        if v is not None:
+            self._cache.move_to_end(key)
+        return v
+
+    def _cache_put(self, key: str, value: dict) -> None:
+        self._cache[key] = value
+        self._cache.move_to_end(key)
+        while len(self._cache) > self.max_entries:
+            self._cache.popitem(last=False)
+
+    def evaluate(
+        self,
+        graph: GraphDocument | GraphSnapshot,
+        *,
+        targets: list[str] | None = None,
+        cancel: CancelToken | None = None,
+        on_progress: Callable[[str, float], None] | None = None,
+        on_node_done: Callable[[NodeResult], None] | None = None,
+    ) -> EvalReport:
+        """Evaluate all nodes (or only what `targets` need) in topological order.
+
+        on_progress(node_id, fraction) is called from kernels' progress;
+        on_node_done(result) after each node.  Both run on the calling thread.
+        """
+        snap = graph.snapshot() if isinstance(graph, GraphDocument) else graph
+        with self._lock:
+            return self._evaluate(snap, targets, cancel, on_progress, on_node_done)
+
+    def _needed(self, snap: GraphSnapshot, targets: list[str] | None) -> list[str]:
+        order = list(snap.order) or topological_order(list(snap.nodes), snap.edges)
+        if targets is None:
+            return order
+        need: set[str] = set()
+        stack = list(targets)
+        while stack:
+            n = stack.pop()
+            if n in need:
+                continue
+            if n not in snap.nodes:
+                raise GraphError(f"no node with id {n!r}", node=n)
+            need.add(n)
+            stack.extend(e.src for e in snap.edges if e.dst == n)
+        return [n for n in order if n in need]
+
+    def _evaluate(self, snap, targets, cancel, on_progress, on_node_done) -> EvalReport:
+        t_start = time.perf_counter()
+        report = EvalReport()
+        keys: dict[str, str] = {}
+        for nid in self._needed(snap, targets):
+            result = self._run_node(snap, nid, keys, report, cancel, on_progress)
+            report.results[nid] = result
+            if on_node_done is not None:
+                on_node_done(result)
+            if result.status == CANCELLED:
+                report.cancelled = True
+                break
+        report.seconds = time.perf_counter() - t_start
+        return report
+
+    def _run_node(self, snap, nid, keys, report, cancel, on_progress) -> NodeResult:
+        type_name, params = snap.nodes[nid]
+        upstream = [e.src for e in snap.edges if e.dst == nid]
+        bad = [u for u in upstream if u not in keys]
+        if bad:
+            return NodeResult(nid, BLOCKED, error=f"waiting for failed input node(s) {sorted(set(bad))}")
+        try:
+            cls = node_type(type_name)
+            params = cls.validate_params(params, nid)
+            check_required_inputs(snap, nid)
+        except (GraphError, KeyError) as exc:
+            msg = exc.args[0] if isinstance(exc, KeyError) else str(exc)
+            return NodeResult(nid, FAILED, error=msg, where=getattr(exc, "where", "") or "")
+        edges_by_port = {p.name: snap.inputs_of(nid, p.name) for p in cls.inputs}
+        key_src = {
+            "t": type_name, "v": cls.version, "p": params,
+            "in": {port: [[keys[e.src], e.src_port] for e in es] for port, es in edges_by_port.items()},
+        }
+        if cls.uses_rng:
+            key_src["seed"] = [snap.seed, nid]
+        key = hashlib.sha256(_canonical(key_src).encode()).hexdigest()
+        cached = self._cache_get(key)
+        if cached is not None:
+            keys[nid] = key
+            report.outputs[nid] = cached
+            return NodeResult(nid, CACHED, key=key)
+        inputs: dict[str, Any] = {}
+        for port in cls.inputs:
+            vals = [report.outputs[e.src][e.src_port] for e in edges_by_port[port.name]]
+            inputs[port.name] = vals if port.multi else (vals[0] if vals else None)
+        ctx = EvalContext(nid, snap.seed, cancel=cancel, report=on_progress)
+        t0 = time.perf_counter()
+        try:
+            ctx.check()
+            outputs = cls().evaluate(inputs, params, ctx)
+            ctx.check()
+        except Cancelled as exc:
+            return NodeResult(nid, CANCELLED, time.perf_counter() - t0, error=str(exc))
+        except Exception as exc:  # a node failure is recorded, never thrown
+            where = getattr(exc, "where", "") or ""
+            msg = str(exc) if isinstance(exc, (GraphError, ValueError)) else f"{type(exc).__name__}: {exc}"
+            if not msg.startswith("node "):
+                msg = f"node {nid!r} ({type_name}): {msg}"
+            return NodeResult(nid, FAILED, time.perf_counter() - t0, error=msg, where=where)
+        missing = [p.name for p in cls.outputs if p.name not in outputs]
+        if missing:
+            return NodeResult(nid, FAILED, time.perf_counter() - t0,
+                              error=f"node {nid!r} ({type_name}) produced no value for {missing}")
+        self._cache_put(key, outputs)
+        keys[nid] = key
+        report.outputs[nid] = outputs
+        return NodeResult(nid, EVALUATED, time.perf_counter() - t0, key=key)

@@ -1,0 +1,199 @@
+"""Node types, their registry and the evaluation context handed to them."""
+
+from __future__ import annotations
+
+import threading
+import time
+import zlib
+from dataclasses import dataclass
+from typing import Any, Callable, ClassVar
+
+import numpy as np
+
+from engine.geometry.cancel import Cancelled  # one cancellation exception for kernels and nodes
+
+from .errors import ParamError
+from .schema import Param, Port
+
+# Families decide a node's colour in the editor (paper Table 1 groups).
+FAMILY_COLOURS = {
+    "topology": (232, 176, 60),
+    "skeleton": (70, 150, 220),
+    "transform": (150, 110, 200),
+    "solid": (90, 180, 110),
+    "property": (210, 90, 90),
+}
+
+
+
+
+class CancelToken:
+    """Thread-safe cancellation flag shared by the UI and a running evaluation."""
+
+    def __init__(self):
+        self._event = threading.Event()
+
+    def cancel(self) -> None:
+        self._event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._event.is_set()
+
+
+class EvalContext:
+    """What a node's evaluate receives besides inputs and parameters.
+
+    rng : numpy.random.Generator seeded from the document seed and node id.
+    progress(done, total) -> bool : reports progress; False means stop.
+    check() : raises Cancelled if the user cancelled.
+    """
+
+    def __init__(
+        self,
+        node_id: str,
+        seed: int,
+        *,
+        cancel: CancelToken | None = None,
+        report: Callable[[str, float], None] | None = None,
+    ):
+        self.node_id = node_id
+        self.seed = node_seed(seed, node_id)
+        self.rng = np.random.default_rng(self.seed)
+        self._cancel = cancel
+        self._report = report
+        self._last = 0.0
+
+    def check(self) -> None:
+        if self._cancel is not None and self._cancel.cancelled:
+            raise Cancelled(f"cancelled while evaluating node {self.node_id!r}")
+
+    def progress(self, done: float, total: float) -> bool:
+        """Kernel progress callback: returns False once cancelled."""
+        if self._report is not None:
+            now = time.perf_counter()
+            if now - self._last > 0.05 or done >= total:
+                self._last = now
+                self._report(self.node_id, min(1.0, max(0.0, float(done) / max(float(total), 1e-12))))
+        return not (self._cancel is not None and self._cancel.cancelled)
+
+
+def node_seed(document_seed: int, node_id: str) -> int:
+    """Deterministic per-node seed: document seed mixed with the node id."""
+    return (int(document_seed) * 1_000_003 + zlib.crc32(node_id.encode("utf-8"))) % (2**63)
+
+
+@dataclass(frozen=True)
+class NodeInfo:
+    """Static description of a node type for UIs and documentation."""
+
+    type_name: str
+    title: str
+    code: str
+    family: str
+    inputs: tuple[Port, ...]
+    outputs: tuple[Port, ...]
+    params: tuple[Param, ...]
+    doc: str
+
+
+class NodeType:
+    """Base class of all node types.
+
+    Subclasses set the class attributes and implement `evaluate`, which must
+    be pure: same inputs and params (and ctx.rng) give the same outputs.
+    ``version`` is part of the cache key; bump it when results change.
+    """
+
+    type_name: ClassVar[str] = ""
+    title: ClassVar[str] = ""
+    code: ClassVar[str] = ""
+    family: ClassVar[str] = "topology"
+    version: ClassVar[int] = 1
+    inputs: ClassVar[tuple[Port, ...]] = ()
+    outputs: ClassVar[tuple[Port, ...]] = ()
+    params: ClassVar[tuple[Param, ...]] = ()
+    uses_rng: ClassVar[bool] = False
+    max_per_graph: ClassVar[int | None] = None
+
+    def evaluate(self, inputs: dict[str, Any], params: dict[str, Any], ctx: EvalContext) -> dict[str, Any]:
+        raise NotImplementedError
+
+    # -- schema helpers -------------------------------------------------
+    @classmethod
+    def param(cls, name: str) -> Param:
+        for p in cls.params:
+            if p.name == name:
+                return p
+        raise KeyError(f"node type {cls.type_name!r} has no parameter {name!r}")
+
+    @classmethod
+    def input_port(cls, name: str) -> Port:
+        for p in cls.inputs:
+            if p.name == name:
+                return p
+        raise KeyError(f"node type {cls.type_name!r} has no input port {name!r}")
+
+    @classmethod
+    def output_port(cls, name: str) -> Port:
+        for p in cls.outputs:
+            if p.name == name:
+                return p
+        raise KeyError(f"node type {cls.type_name!r} has no output port {name!r}")
+
+    @classmethod
+    def default_params(cls) -> dict[str, Any]:
+        return {p.name: p.coerce(p.default) for p in cls.params}
+
+    @classmethod
+    def validate_params(cls, params: dict[str, Any], node_id: str | None = None) -> dict[str, Any]:
+        """Full, canonical parameter dict: defaults filled in, unknown names refused."""
+        out = cls.default_params()
+        for name, value in params.items():
+            try:
+                p = cls.param(name)
+            except KeyError:
+                known = ", ".join(q.name for q in cls.params) or "none"
+                raise ParamError(name, value, f"a parameter of {cls.type_name} (known: {known})", node=node_id) from None
+            try:
+                out[name] = p.coerce(value)
+            except ParamError as exc:
+                raise exc.on_node(node_id) if node_id else exc
+        return out
+
+    @classmethod
+    def info(cls) -> NodeInfo:
+        return NodeInfo(cls.type_name, cls.title or cls.type_name, cls.code, cls.family,
+                        cls.inputs, cls.outputs, cls.params, (cls.__doc__ or "").strip())
+
+
+_REGISTRY: dict[str, type[NodeType]] = {}
+
+
+def register(cls: type[NodeType]) -> type[NodeType]:
+    """Class decorator adding a node type to the registry."""
+    if not cls.type_name:
+        raise ValueError(f"{cls.__name__} has no type_name")
+    if cls.type_name in _REGISTRY and _REGISTRY[cls.type_name] is not cls:
+        raise ValueError(f"node type {cls.type_name!r} registered twice")
+    _REGISTRY[cls.type_name] = cls
+    return cls
+
+
+def node_type(type_name: str) -> type[NodeType]:
+    _ensure_builtin_nodes()
+    try:
+        return _REGISTRY[type_name]
+    except KeyError:
+        raise KeyError(f"unknown node type {type_name!r} (known: {', '.join(sorted(_REGISTRY))})") from None
+
+
+def all_node_types() -> dict[str, type[NodeType]]:
+    _ensure_builtin_nodes()
+    return dict(_REGISTRY)
+
+
+def _ensure_builtin_nodes() -> None:
+    # The node modules register themselves on import; importing lazily keeps
+    # engine.graph free of a hard dependency on engine.nodes at import time.
+    import engine.nodes  # noqa: F401

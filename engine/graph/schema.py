@@ -1,0 +1,173 @@
+"""Port and parameter schemas of node types.
+
+A node type declares its ports (typed, possibly multi-input) and a parameter
+schema (kind, range, default, unit).  Parameter values are validated here, at
+the boundary, with messages that name the parameter, the value and what was
+expected; the evaluator and the undo commands both go through `Param.coerce`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from .errors import ParamError
+
+# Port types.  A "Skeleton" port accepts lines, surfaces and their transforms;
+# the later surface work plugs in by producing Skeleton values too.
+PORT_TYPES = (
+    "Point",
+    "EdgeChain",
+    "Skeleton",
+    "Solid",
+    "Voxel",
+    "Stiffness",
+    "Spectrum",
+    "Field",
+    "Mesh",
+    "TileSet",
+    "Tiling",
+)
+
+PARAM_KINDS = ("float", "int", "bool", "enum", "vec3", "str", "samples", "int_list")
+
+
+def ports_compatible(source_type: str, target_type: str) -> bool:
+    """Whether an output of `source_type` may feed an input of `target_type`."""
+    return source_type == target_type
+
+
+@dataclass(frozen=True)
+class Port:
+    """A typed input or output of a node type.
+
+    ``multi`` inputs accept several connections; their order is the order of
+    connection and is meaningful (e.g. the vertex order of an edge chain).
+    """
+
+    name: str
+    type: str
+    required: bool = True
+    multi: bool = False
+    doc: str = ""
+
+    def __post_init__(self):
+        if self.type not in PORT_TYPES:
+            raise ValueError(f"port {self.name!r}: unknown port type {self.type!r}")
+
+
+def _finite(name: str, value: Any) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParamError(name, value, "a number") from None
+    if not math.isfinite(x):
+        raise ParamError(name, value, "a finite number")
+    return x
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a node type.
+
+    kind : one of PARAM_KINDS.
+        ``samples`` is a list of ``[t, value]`` pairs with t in [0, 1] (sparse
+        thickness profile); ``int_list`` a list of integers; ``vec3`` three floats.
+    minimum, maximum : inclusive range for float / int / vec3 components and
+        for the values of ``samples``.
+    """
+
+    name: str
+    kind: str
+    default: Any
+    minimum: float | None = None
+    maximum: float | None = None
+    unit: str = ""
+    choices: tuple = ()
+    doc: str = ""
+    label: str = field(default="")
+
+    def __post_init__(self):
+        if self.kind not in PARAM_KINDS:
+            raise ValueError(f"parameter {self.name!r}: unknown kind {self.kind!r}")
+
+    # -- validation -----------------------------------------------------
+    def _check_range(self, value: float, shown: Any = None) -> None:
+        lo, hi = self.minimum, self.maximum
+        if (lo is not None and value < lo) or (hi is not None and value > hi):
+            rng = f"[{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}]"
+            raise ParamError(self.name, value if shown is None else shown, f"a value in {rng}")
+
+    def coerce(self, value: Any) -> Any:
+        """Return the canonical JSON-able form of `value` or raise ParamError."""
+        k = self.kind
+        if k == "float":
+            x = _finite(self.name, value)
+            self._check_range(x)
+            return x
+        if k == "int":
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
+                raise ParamError(self.name, value, "an integer")
+            x = int(value)
+            self._check_range(x)
+            return x
+        if k == "bool":
+            if not isinstance(value, bool):
+                raise ParamError(self.name, value, "true or false")
+            return value
+        if k == "enum":
+            if value not in self.choices:
+                raise ParamError(self.name, value, f"one of {list(self.choices)}")
+            return value
+        if k == "str":
+            if not isinstance(value, str):
+                raise ParamError(self.name, value, "a string")
+            return value
+        if k == "vec3":
+            if not isinstance(value, (list, tuple)) or len(value) != 3:
+                raise ParamError(self.name, value, "a list of three numbers")
+            out = [_finite(self.name, v) for v in value]
+            for v in out:
+                self._check_range(v, value)
+            return out
+        if k == "int_list":
+            if not isinstance(value, (list, tuple)):
+                raise ParamError(self.name, value, "a list of integers")
+            out = []
+            for v in value:
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or int(v) != v:
+                    raise ParamError(self.name, value, "a list of integers")
+                out.append(int(v))
+                self._check_range(int(v), value)
+            return out
+        if k == "samples":
+            if not isinstance(value, (list, tuple)) or len(value) == 0:
+                raise ParamError(self.name, value, "a non-empty list of [t, value] pairs")
+            out = []
+            for pair in value:
+                if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+                    raise ParamError(self.name, value, "a list of [t, value] pairs")
+                t = _finite(self.name, pair[0])
+                v = _finite(self.name, pair[1])
+                if not 0.0 <= t <= 1.0:
+                    raise ParamError(self.name, value, "sample positions t in [0, 1]")
+                self._check_range(v, value)
+                out.append([t, v])
+            out.sort(key=lambda p: p[0])
+            return out
+        raise AssertionError(k)
+
+    def to_dict(self) -> dict:
+        """Describe the parameter for UIs and documentation."""
+        return {
+            "name": self.name,
+            "label": self.label or self.name.replace("_", " "),
+            "kind": self.kind,
+            "default": self.default,
+            "min": self.minimum,
+            "max": self.maximum,
+            "unit": self.unit,
+            "choices": list(self.choices),
+            "doc": self.doc,
+        }

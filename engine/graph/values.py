@@ -1,0 +1,166 @@
+"""Typed values that travel on ports.  Immutable once produced.
+
+Arrays inside are set read-only on construction so a downstream node cannot
+change a cached upstream result by accident.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _frozen(a, dtype=np.float64) -> np.ndarray:
+    arr = np.array(a, dtype=dtype, copy=True)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True)
+class Point:
+    """A vertex position, unit-cell coordinates."""
+
+    xyz: np.ndarray  # (3,) float64
+
+    def __post_init__(self):
+        object.__setattr__(self, "xyz", _frozen(self.xyz).reshape(3))
+
+
+@dataclass(frozen=True)
+class EdgeChain:
+    """An ordered vertex path with a smoothness flag (paper 6.1).
+
+    points : (n, 3) float64; closed : the path returns to its first vertex;
+    period : (3,) translation for curves that continue into the next cell, or None.
+    """
+
+    points: np.ndarray
+    smooth: bool
+    closed: bool = False
+    period: np.ndarray | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "points", _frozen(self.points).reshape(-1, 3))
+        if self.period is not None:
+            object.__setattr__(self, "period", _frozen(self.period).reshape(3))
+
+
+@dataclass(frozen=True)
+class LineElement:
+    """A thickened-line skeleton element: dense polyline + thickness per vertex.
+
+    polyline : (m, 3) float64, unit-cell coordinates.
+    thickness : (m,) float64, diameter at each polyline vertex.
+    control_points : (k, 3) float64, the user's vertices (for display).
+    """
+
+    polyline: np.ndarray
+    thickness: np.ndarray
+    control_points: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "polyline", _frozen(self.polyline).reshape(-1, 3))
+        object.__setattr__(self, "thickness", _frozen(self.thickness).reshape(-1))
+        object.__setattr__(self, "control_points", _frozen(self.control_points).reshape(-1, 3))
+        if len(self.thickness) != len(self.polyline):
+            raise ValueError("LineElement: thickness must have one value per polyline vertex")
+
+    def transformed(self, matrix: np.ndarray, offset: np.ndarray, scale: float) -> "LineElement":
+        return LineElement(self.polyline @ matrix.T + offset, self.thickness * scale,
+                           self.control_points @ matrix.T + offset)
+
+
+@dataclass(frozen=True)
+class SurfaceElement:
+    """A thickened-surface skeleton element (triangle mesh + thickness per vertex)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    thickness: np.ndarray
+    boundary: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+
+    def __post_init__(self):
+        object.__setattr__(self, "vertices", _frozen(self.vertices).reshape(-1, 3))
+        object.__setattr__(self, "faces", _frozen(self.faces, np.int64).reshape(-1, 3))
+        object.__setattr__(self, "thickness", _frozen(self.thickness).reshape(-1))
+        object.__setattr__(self, "boundary", _frozen(self.boundary).reshape(-1, 3))
+
+    def transformed(self, matrix: np.ndarray, offset: np.ndarray, scale: float) -> "SurfaceElement":
+        faces = self.faces if np.linalg.det(matrix) > 0 else self.faces[:, ::-1]
+        return SurfaceElement(self.vertices @ matrix.T + offset, faces, self.thickness * scale,
+                              self.boundary @ matrix.T + offset)
+
+
+@dataclass(frozen=True)
+class Skeleton:
+    """A set of line and surface elements."""
+
+    elements: tuple = ()
+
+    @property
+    def lines(self) -> list[LineElement]:
+        return [e for e in self.elements if isinstance(e, LineElement)]
+
+    @property
+    def surfaces(self) -> list[SurfaceElement]:
+        return [e for e in self.elements if isinstance(e, SurfaceElement)]
+
+    def transformed(self, matrix, offset, scale=1.0) -> "Skeleton":
+        m = np.asarray(matrix, float)
+        o = np.asarray(offset, float)
+        return Skeleton(tuple(e.transformed(m, o, float(scale)) for e in self.elements))
+
+    def __add__(self, other: "Skeleton") -> "Skeleton":
+        return Skeleton(self.elements + other.elements)
+
+
+@dataclass(frozen=True)
+class Solid:
+    """A tileable solid over the periodic unit cell.
+
+    sdf : (N, N, N) float32 signed distance (negative inside) at nodes i/N,
+        exactly periodic, so opposite faces agree by construction.
+    vertices, faces : the single-cell mesh from marching cubes (closed).
+    cell_size : edge of the unit cell in model units (mm).
+    """
+
+    sdf: np.ndarray
+    vertices: np.ndarray
+    faces: np.ndarray
+    cell_size: float = 1.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "sdf", _frozen(self.sdf, np.float32))
+        object.__setattr__(self, "vertices", _frozen(self.vertices).reshape(-1, 3))
+        object.__setattr__(self, "faces", _frozen(self.faces, np.int64).reshape(-1, 3))
+
+    @property
+    def resolution(self) -> int:
+        return int(self.sdf.shape[0])
+
+    @property
+    def volume_fraction(self) -> float:
+        return float(np.count_nonzero(self.sdf < 0) / self.sdf.size)
+
+
+@dataclass(frozen=True)
+class VoxelModel:
+    """Occupancy voxels of a solid plus its base material (paper 6.5 Voxel node).
+
+    occupancy : (N, N, N) bool, voxel (i, j, k) covers [i, i+1)/N etc.
+    E : Young's modulus (Pa), nu : Poisson's ratio, rho : density (kg/m^3).
+    """
+
+    occupancy: np.ndarray
+    E: float
+    nu: float
+    rho: float
+    solid: Solid
+
+    def __post_init__(self):
+        object.__setattr__(self, "occupancy", _frozen(self.occupancy, bool))
+
+    @property
+    def volume_fraction(self) -> float:
+        return float(self.occupancy.mean())

@@ -1,0 +1,164 @@
+"""The example graphs in resources/examples: they evaluate, tile and stay in sync.
+
+Every ``resources/examples/*.json`` is loaded, its Object resolution lowered
+to keep the run short, and evaluated.  The final solid (the Voxel node's
+input) must be a closed mesh that tiles: the single-cell mesh matches across
+opposite faces, and a 2x2x2 block is one closed, connected piece.  The node
+count must stay within +-30% of the paper's Table 4 (Makatura et al. 2023),
+and the files must be exactly what ``tools/make_examples.py`` writes.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from engine.graph import Evaluator, SetParam, UndoStack, load_project
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES_DIR = ROOT / "resources" / "examples"
+FILES = sorted(EXAMPLES_DIR.glob("*.json"))
+TEST_RESOLUTION = 48
+
+# Table 4, column #all.  BCC is not in the paper; 12 is our own reference
+# (the paper's smallest truss graph, the octet, has 12 nodes).
+PAPER_NODE_COUNT = {
+    "octet": 12,
+    "bcc": 12,
+    "fcc_lattice": 19,       # "3D FCC lattice"
+    "auxetic3d": 17,
+    "anti_chiral": 13,
+    "assembled": 20,
+    "assembled2": 15,
+    "assembled3": 15,
+    "twist_tilable": 33,
+    "six_hole_bcc": 27,      # "6-hole BCC"
+    "bandgap": 30,
+}
+VOLUME_FRACTION_BAND = (0.02, 0.6)
+
+
+def _load_generator():
+    spec = importlib.util.spec_from_file_location("make_examples", ROOT / "tools" / "make_examples.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@functools.lru_cache(maxsize=None)
+def _evaluated(path: Path):
+    """(document, report, final solid) at the test resolution; cached per file."""
+    doc = load_project(path)
+    stack = UndoStack(doc)
+    for node_id, node in doc.nodes.items():
+        if node.type_name == "Object":
+            stack.push(SetParam(node_id, "resolution", TEST_RESOLUTION))
+    report = Evaluator().evaluate(doc)
+    voxels = [n for n, node in doc.nodes.items() if node.type_name == "Voxel"]
+    solid = None
+    if report.ok and len(voxels) == 1:
+        (edge,) = doc.inputs_of(voxels[0], "solid")
+        solid = report.outputs[edge.src][edge.src_port]
+    return doc, report, solid
+
+
+def _mesh(vertices, faces) -> trimesh.Trimesh:
+    return trimesh.Trimesh(np.asarray(vertices, float), np.asarray(faces, np.int64), process=True)
+
+
+def _components(mesh: trimesh.Trimesh) -> int:
+    return len(mesh.split(only_watertight=False))
+
+
+@pytest.fixture(params=FILES, ids=[p.stem for p in FILES])
+def example(request):
+    doc, report, solid = _evaluated(request.param)
+    assert report.ok, f"{request.param.name}: failed nodes {report.errors}"
+    return request.param.stem, doc, solid
+
+
+def test_every_generated_example_is_present():
+    generator = _load_generator()
+    assert sorted(p.stem for p in FILES) == sorted(generator.EXAMPLES)
+    assert sorted(PAPER_NODE_COUNT) == sorted(generator.EXAMPLES)
+
+
+def test_files_are_what_the_generator_writes(tmp_path):
+    generator = _load_generator()
+    generator.write_examples(tmp_path)
+    fresh = {p.name: json.loads(p.read_text()) for p in sorted(tmp_path.glob("*.json"))}
+    stored = {p.name: json.loads(p.read_text()) for p in FILES}
+    assert sorted(fresh) == sorted(stored)
+    for name in fresh:
+        assert fresh[name] == stored[name], f"{name} differs from tools/make_examples.py: regenerate it"
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
+def test_graph_shape(path):
+    doc = load_project(path)
+    types = [n.type_name for n in doc.nodes.values()]
+    assert types.count("Voxel") == 1
+    (vox,) = [n for n in doc.nodes.values() if n.type_name == "Voxel"]
+    assert vox.params["E"] == 1.0 and vox.params["nu"] == 0.45 and vox.params["rho"] == 1.0
+    objects = [n for n in doc.nodes.values() if n.type_name == "Object"]
+    assert objects and all(n.params["resolution"] == 96 for n in objects)
+    reference = PAPER_NODE_COUNT[path.stem]
+    assert 0.7 * reference <= len(doc.nodes) <= 1.3 * reference, \
+        f"{path.stem}: {len(doc.nodes)} nodes, paper {reference}"
+    paper = doc.meta.get("paper_node_count")
+    assert paper is None or paper == reference
+    # the editor layout runs left to right: every edge goes to a later column
+    for e in doc.edges:
+        assert doc.node(e.src).position[0] < doc.node(e.dst).position[0]
+
+
+def test_evaluates_to_one_voxel_model(example):
+    name, doc, solid = example
+    assert solid is not None
+    assert solid.resolution == TEST_RESOLUTION
+
+
+def test_final_solid_is_closed(example):
+    name, doc, solid = example
+    mesh = _mesh(solid.vertices, solid.faces)
+    assert mesh.is_watertight, f"{name}: single-cell mesh is not closed"
+    assert mesh.volume > 0.0
+
+
+def test_volume_fraction_is_plausible(example):
+    name, doc, solid = example
+    lo, hi = VOLUME_FRACTION_BAND
+    assert lo < solid.volume_fraction < hi, f"{name}: volume fraction {solid.volume_fraction:.3f}"
+    mesh = _mesh(solid.vertices, solid.faces)
+    # the mesh volume (cell size 1) agrees with the voxel count
+    assert abs(mesh.volume - solid.volume_fraction) < 0.25 * solid.volume_fraction + 0.01
+
+
+def test_cell_faces_match(example):
+    from engine.geometry.marching import boundary_section_match
+    name, doc, solid = example
+    assert boundary_section_match(solid.vertices, solid.faces, cell_size=solid.cell_size) < 1e-6
+
+
+def test_single_cell_is_connected(example):
+    # Every example is designed so that the members inside one cell already
+    # hang together (each piece cut by a cell face is attached to the rest).
+    name, doc, solid = example
+    assert _components(_mesh(solid.vertices, solid.faces)) == 1, f"{name}: cell falls apart"
+
+
+def test_tiled_block_is_one_closed_piece(example):
+    from engine.geometry.marching import periodic_mesh
+    name, doc, solid = example
+    vertices, faces = periodic_mesh(solid.sdf, cell_size=solid.cell_size, tiles=(2, 2, 2))
+    mesh = _mesh(vertices, faces)
+    assert mesh.is_watertight, f"{name}: 2x2x2 block is not closed"
+    assert _components(mesh) == 1, f"{name}: 2x2x2 block falls apart"
+    single = _mesh(solid.vertices, solid.faces)
+    assert mesh.volume == pytest.approx(8.0 * single.volume, rel=1e-3)

@@ -1,0 +1,66 @@
+"""Evaluation runs off the GUI thread, can be cancelled, and restarts on newer edits."""
+
+from __future__ import annotations
+
+import time
+
+from PySide6 import QtCore
+
+from engine.graph import SetParam
+
+
+def test_cancel_slow_evaluation_keeps_window_responsive(window, qtbot, slow_graph):
+    window.act_auto.setChecked(False)
+    ids = slow_graph(window.undo, resolution=256)
+    assert window.evaluation_idle                         # auto-evaluate off: nothing scheduled
+    ticks = []                                            # the GUI thread keeps processing events
+    timer = QtCore.QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(20)
+    window.evaluate_now()
+    assert window.worker.is_running
+    assert window.cancel_button.isEnabled()
+    # cancel while the Object node computes its distance field (it reports progress)
+    qtbot.waitUntil(lambda: window.progress.format().startswith(ids["obj"]), timeout=60000)
+    qtbot.wait(150)
+    assert window.worker.is_running, "the slow graph finished before it could be cancelled"
+    t0 = time.perf_counter()
+    qtbot.mouseClick(window.cancel_button, QtCore.Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: window.evaluation_idle, timeout=5000)
+    latency = time.perf_counter() - t0
+    timer.stop()
+    assert latency < 1.0
+    report = window.last_report
+    assert report.cancelled
+    assert report.results[ids["obj"]].status == "cancelled"
+    assert window.progress.format() == "cancelled"
+    assert not window.cancel_button.isEnabled()
+    assert len(ticks) >= 5
+    assert max(b - a for a, b in zip(ticks, ticks[1:])) < 0.5
+
+
+def test_newer_edit_supersedes_running_evaluation(window, qtbot, slow_graph, wait_eval):
+    window.act_auto.setChecked(False)
+    ids = slow_graph(window.undo, resolution=256)
+    window.evaluate_now()
+    qtbot.waitUntil(lambda: window.progress.format().startswith(ids["obj"]), timeout=30000)
+    window.act_auto.setChecked(True)
+    n = window.eval_count
+    window.undo.push(SetParam(ids["obj"], "resolution", 24))   # debounced restart with the new snapshot
+    report = wait_eval(window, n)
+    assert not report.cancelled and report.ok, report.errors
+    assert window.eval_count == n + 1                          # the superseded run was not reported
+    assert window.current_solid().resolution == 24
+
+
+def test_debounce_merges_quick_edits(window, qtbot, strut_graph, wait_eval):
+    ids = strut_graph(window.undo, resolution=16)
+    wait_eval(window, 0)
+    started = []
+    window.worker.started.connect(started.append)
+    n = window.eval_count
+    for r in (17, 18, 19, 20):
+        window.undo.push(SetParam(ids["obj"], "resolution", r), merge=True)
+    wait_eval(window, n)
+    assert len(started) == 1
+    assert window.current_solid().resolution == 20

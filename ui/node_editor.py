@@ -1,0 +1,519 @@
+"""The node editor: a NodeGraphQt scene that is a *view* of a GraphDocument.
+
+The document is the source of truth.  User gestures in the scene (create a
+node from the tab search or the context menu, connect, disconnect, slice,
+move, delete, rename) are translated into engine commands pushed on the
+`UndoStack`; the scene is then brought in line with the document from its
+events.  NodeGraphQt draws some changes before telling us (a dragged pipe is
+already detached, a moved node already sits at its new place); after every
+gesture `sync_edges` reconciles the scene with the document, which also
+reverts whatever the engine refused.  NodeGraphQt's own undo stack is never
+used.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from NodeGraphQt import BaseNode, NodeGraph
+from NodeGraphQt.base.commands import PortConnectedCmd, PortDisconnectedCmd
+from NodeGraphQt.constants import PortTypeEnum
+from NodeGraphQt.qgraphics.node_base import NodeItem
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from engine.graph import (FAMILY_COLOURS, AddNode, Connect, Disconnect, Edge, GraphDocument, GraphError,
+                          Macro, MoveNode, RemoveNode, SetLabel, UndoStack, all_node_types)
+
+FAMILY_ORDER = ("topology", "skeleton", "transform", "solid", "property")
+
+# Port dot colours by value type, so compatible ends are recognisable at a glance.
+PORT_COLOURS = {
+    "Point": (240, 200, 90),
+    "EdgeChain": (245, 150, 60),
+    "Skeleton": (90, 170, 240),
+    "Solid": (110, 210, 130),
+    "Voxel": (60, 160, 90),
+    "Stiffness": (230, 100, 100),
+    "Spectrum": (230, 120, 200),
+    "Field": (200, 200, 200),
+    "Mesh": (160, 220, 220),
+    "TileSet": (180, 140, 240),
+    "Tiling": (140, 120, 220),
+}
+
+STATUS_PENS = {
+    "failed": ((230, 40, 40), 3.5),
+    "blocked": ((230, 150, 40), 2.5),
+    "cancelled": ((150, 150, 150), 2.5),
+}
+
+
+class StatusNodeItem(NodeItem):
+    """A node item that outlines itself by evaluation status (red = failed)."""
+
+    def __init__(self, name="node", parent=None):
+        super().__init__(name, parent)
+        self.status = ""
+        self._proxy_mode_threshold = 36  # keep titles readable when zoomed out to fit a graph
+
+    def paint(self, painter, option, widget):
+        super().paint(painter, option, widget)
+        pen_spec = STATUS_PENS.get(self.status)
+        if pen_spec is None:
+            return
+        colour, width = pen_spec
+        painter.save()
+        pen = QtGui.QPen(QtGui.QColor(*colour), width)
+        painter.setPen(pen)
+        painter.setBrush(QtCore.Qt.BrushStyle.NoBrush)
+        r = self.boundingRect().adjusted(1.0, 1.0, -1.0, -1.0)
+        painter.drawRoundedRect(r, 5.0, 5.0)
+        painter.restore()
+
+
+class EngineNode(BaseNode):
+    """Base of the generated NodeGraphQt classes; ENGINE_TYPE names the engine node type."""
+
+    __identifier__ = "mesoforge"
+    NODE_NAME = "Node"
+    ENGINE_TYPE = ""
+
+    def __init__(self):
+        super().__init__(qgraphics_item=StatusNodeItem)
+        cls = all_node_types()[self.ENGINE_TYPE]
+        for port in cls.inputs:
+            self.add_input(port.name, multi_input=port.multi, color=PORT_COLOURS.get(port.type))
+        for port in cls.outputs:
+            self.add_output(port.name, multi_output=True, color=PORT_COLOURS.get(port.type))
+        r, g, b = FAMILY_COLOURS.get(cls.family, (120, 120, 120))
+        self.set_color(r, g, b)
+
+
+def family_shade(family: str, factor: float) -> tuple[int, int, int]:
+    r, g, b = FAMILY_COLOURS.get(family, (120, 120, 120))
+    return (int(r * factor), int(g * factor), int(b * factor))
+
+
+def make_node_classes() -> dict[str, type[EngineNode]]:
+    """One NodeGraphQt class per engine node type, keyed by engine type name."""
+    classes = {}
+    for type_name, cls in sorted(all_node_types().items()):
+        classes[type_name] = type(
+            f"{type_name}Node", (EngineNode,),
+            {"__identifier__": f"mesoforge.{cls.family}", "NODE_NAME": cls.title or type_name,
+             "ENGINE_TYPE": type_name})
+    return classes
+
+
+class _DocumentNodeGraph(NodeGraph):
+    """NodeGraph whose gesture handlers hand over to the editor instead of
+    editing NodeGraphQt's own model."""
+
+    def __init__(self, editor: "NodeEditor", **kwargs):
+        self._editor = editor
+        super().__init__(**kwargs)
+
+    def _on_connection_changed(self, disconnected, connected):
+        self._editor.gesture_connections(disconnected, connected)
+
+    def _on_connection_sliced(self, ports):
+        self._editor.gesture_connections(ports, [])
+
+    def _on_nodes_moved(self, node_data):
+        self._editor.gesture_moved(node_data)
+
+    def _on_search_triggered(self, node_type, pos):
+        self._editor.gesture_create(node_type, pos)
+
+    def _on_insert_node(self, pipe, node_id, prev_node_pos):
+        # Dropping a node onto a pipe is only a move here.
+        self._editor.gesture_moved(prev_node_pos)
+
+    def _on_node_name_changed(self, node_id, name):
+        self._editor.gesture_rename(node_id, name)
+
+    def _on_node_data_dropped(self, mimedata, pos):
+        pass  # NodeGraphQt would import its own session files
+
+    def _on_context_menu_prompt(self, menu_name, node_id):
+        self._editor.menu_scene_pos = self.cursor_pos()
+        super()._on_context_menu_prompt(menu_name, node_id)
+
+    def delete_nodes(self, nodes, push_undo=True):
+        self._editor.gesture_delete([n.id for n in nodes])
+
+    def delete_node(self, node, push_undo=True):
+        self._editor.gesture_delete([node.id])
+
+
+class NodeEditor(QtWidgets.QWidget):
+    """Node editor widget over a document and its undo stack.
+
+    Signals
+    -------
+    selection_changed(object) : the selected engine node id, or None.
+    message(str, str) : (level, text) for the log; level is "info" or "error".
+    """
+
+    selection_changed = QtCore.Signal(object)
+    message = QtCore.Signal(str, str)
+
+    def __init__(self, doc: GraphDocument, undo: UndoStack, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.undo = undo
+        self.menu_scene_pos: tuple[float, float] | None = None
+        self._node_classes = make_node_classes()
+        self._engine_type_of = {cls.type_: name for name, cls in self._node_classes.items()}
+        self._by_id: dict[str, BaseNode] = {}   # engine id -> scene node
+        self._id_of: dict[str, str] = {}        # scene node id -> engine id
+        self._statuses: dict[str, Any] = {}
+        self._selected: str | None = None
+
+        self.graph = _DocumentNodeGraph(self)
+        self.graph.set_background_color(34, 36, 40)
+        self.graph.set_grid_color(48, 51, 56)
+        self.graph.set_acyclic(True)
+        self.graph.register_nodes(list(self._node_classes.values()))
+        self._disable_own_undo()
+        self._build_context_menu()
+        self.graph.node_selection_changed.connect(self._on_selection_changed)
+        self.graph.node_selected.connect(lambda _n: self._on_selection_changed([], []))
+
+        layout = QtWidgets.QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.graph.widget)
+
+        tab = QtGui.QShortcut(QtGui.QKeySequence(QtCore.Qt.Key.Key_Tab), self.graph.widget)
+        tab.setContext(QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        tab.activated.connect(self.graph.toggle_node_search)
+
+        doc.subscribe(self._on_doc_event)
+        self.rebuild()
+
+    # -- setup ------------------------------------------------------------
+    def _disable_own_undo(self) -> None:
+        # NodeGraphQt binds Ctrl+Z to its private QUndoStack inside the viewer;
+        # that would shadow the window's (engine) undo, so those actions go.
+        viewer = self.graph.viewer()
+        for name in ("_undo_action", "_redo_action"):
+            action = getattr(viewer, name, None)
+            if action is not None:
+                action.setShortcuts([])
+                action.setEnabled(False)
+                action.setVisible(False)
+
+    def _build_context_menu(self) -> None:
+        menu = self.graph.get_context_menu("graph")
+        add = menu.add_menu("Add node")
+        types = all_node_types()
+        for family in FAMILY_ORDER:
+            names = [n for n, c in types.items() if c.family == family]
+            if not names:
+                continue
+            sub = add.add_menu(family.capitalize())
+            for name in sorted(names, key=lambda n: types[n].title or n):
+                sub.add_command(types[name].title or name,
+                                lambda _graph, _name=name: self.create_node(_name, self.menu_scene_pos))
+        menu.add_separator()
+        menu.add_command("Delete selected", lambda _graph: self.delete_selected())
+        menu.add_command("Fit view", lambda _graph: self.fit_view())
+
+    def detach(self) -> None:
+        """Stop listening to the document (window closing)."""
+        self.doc.unsubscribe(self._on_doc_event)
+
+    # -- queries (also used by tests) -----------------------------------------
+    def scene_node(self, node_id: str) -> BaseNode | None:
+        return self._by_id.get(node_id)
+
+    def scene_node_ids(self) -> set[str]:
+        return set(self._by_id)
+
+    def scene_edges(self) -> set[Edge]:
+        """Connections as the scene draws them (model and pipes must agree)."""
+        edges = set()
+        for nid, node in self._by_id.items():
+            for port in node.input_ports():
+                for other in port.connected_ports():
+                    src = self._id_of.get(other.node().id)
+                    if src is not None:
+                        edges.add(Edge(src, other.name(), nid, port.name()))
+        return edges
+
+    def scene_pipe_count(self) -> int:
+        return sum(len(p.view.connected_pipes) for n in self._by_id.values() for p in n.input_ports())
+
+    def selected_ids(self) -> list[str]:
+        return [self._id_of[n.id] for n in self.graph.selected_nodes() if n.id in self._id_of]
+
+    # -- document -> scene ------------------------------------------------
+    def _display_name(self, node_id: str) -> str:
+        inst = self.doc.nodes[node_id]
+        cls = all_node_types()[inst.type_name]
+        return f"{inst.label or cls.title or inst.type_name}  ·  {node_id}"
+
+    def _on_doc_event(self, event: str, payload) -> None:
+        if event == "node_added":
+            self._add_scene_node(payload)
+        elif event == "node_removed":
+            self._remove_scene_node(payload)
+        elif event in ("edge_added", "edge_removed"):
+            self.sync_edges()
+        elif event == "node_moved":
+            self._move_scene_node(payload)
+        elif event == "label_changed":
+            node = self._by_id.get(payload)
+            if node is not None:
+                node.set_property("name", self._display_name(payload), push_undo=False)
+        elif event == "param_changed":
+            self._update_tooltip(payload[0])
+        elif event == "reset":
+            self.rebuild()
+
+    def rebuild(self) -> None:
+        """Drop the whole scene and draw the document anew."""
+        for nid in list(self._by_id):
+            self._remove_scene_node(nid)
+        self._statuses.clear()
+        for nid in self.doc.nodes:
+            self._add_scene_node(nid)
+        self.sync_edges()
+        self._emit_selection()
+
+    def _add_scene_node(self, node_id: str) -> None:
+        if node_id in self._by_id:
+            return
+        inst = self.doc.nodes[node_id]
+        cls = self._node_classes[inst.type_name]
+        node = self.graph.create_node(cls.type_, name=self._display_name(node_id), selected=False,
+                                      pos=list(inst.position), push_undo=False)
+        family = all_node_types()[inst.type_name].family
+        node.set_property("text_color", (245, 245, 245, 255), push_undo=False)
+        node.set_property("border_color", (*family_shade(family, 1.0), 255), push_undo=False)
+        node.set_property("color", (*family_shade(family, 0.62), 255), push_undo=False)
+        self._by_id[node_id] = node
+        self._id_of[node.id] = node_id
+        self._update_tooltip(node_id)
+
+    def _remove_scene_node(self, node_id: str) -> None:
+        node = self._by_id.pop(node_id, None)
+        if node is None:
+            return
+        self._id_of.pop(node.id, None)
+        self._statuses.pop(node_id, None)
+        self.graph.remove_node(node, push_undo=False)
+        if self._selected == node_id:
+            self._emit_selection()
+
+    def _move_scene_node(self, node_id: str) -> None:
+        node = self._by_id.get(node_id)
+        if node is None:
+            return
+        x, y = self.doc.nodes[node_id].position
+        # NodeGraphQt's model and item both hold a position; a drag moved only the item.
+        node.model.pos = [x, y]
+        if list(node.view.xy_pos) != [x, y]:
+            node.view.xy_pos = [x, y]
+
+    def sync_edges(self) -> None:
+        """Make the scene's connections (model and drawn pipes) equal the document's."""
+        want = {e for e in self.doc.edges if e.src in self._by_id and e.dst in self._by_id}
+        have = self.scene_edges()
+        for e in have - want:
+            inp, out = self._ports(e)
+            PortDisconnectedCmd(inp, out, False).redo()
+        for e in want - have:
+            inp, out = self._ports(e)
+            if inp is not None and out is not None:
+                PortConnectedCmd(inp, out, False).redo()
+        # A pipe dragged off a port is already gone from the scene while
+        # NodeGraphQt's model still holds it; redraw missing pipes, drop extra ones.
+        for nid, node in self._by_id.items():
+            for port in node.input_ports():
+                model_peers = {p.view for p in port.connected_ports()}
+                drawn_peers = {pipe.output_port for pipe in port.view.connected_pipes}
+                for peer in model_peers - drawn_peers:
+                    port.view.connect_to(peer)
+                for peer in drawn_peers - model_peers:
+                    port.view.disconnect_from(peer)
+
+    def _ports(self, edge: Edge):
+        src, dst = self._by_id.get(edge.src), self._by_id.get(edge.dst)
+        out = src.outputs().get(edge.src_port) if src is not None else None
+        inp = dst.inputs().get(edge.dst_port) if dst is not None else None
+        return inp, out
+
+    def _update_tooltip(self, node_id: str) -> None:
+        node = self._by_id.get(node_id)
+        inst = self.doc.nodes.get(node_id)
+        if node is None or inst is None:
+            return
+        cls = all_node_types()[inst.type_name]
+        lines = [f"<b>{cls.title or inst.type_name}</b> ({node_id}) — {cls.family}"]
+        doc = " ".join((cls.__doc__ or "").split())
+        if doc:
+            lines.append(f"<i>{_html_escape(doc)}</i>")
+        result = self._statuses.get(node_id)
+        if result is not None:
+            lines.append(f"status: <b>{result.status}</b> ({result.seconds:.2f} s)")
+            if result.error:
+                lines.append(f"<span style='color:#e04040'>{_html_escape(result.error)}</span>")
+        node.view.setToolTip("<br/>".join(lines))
+
+    # -- evaluation status --------------------------------------------------
+    def set_results(self, results: dict) -> None:
+        """Mark nodes by their latest `NodeResult` (failed: red outline and tooltip)."""
+        self._statuses = dict(results)
+        for nid, node in self._by_id.items():
+            result = results.get(nid)
+            node.view.status = result.status if result is not None else ""
+            self._update_tooltip(nid)
+            node.view.update()
+
+    def node_status(self, node_id: str) -> str:
+        node = self._by_id.get(node_id)
+        return node.view.status if node is not None else ""
+
+    # -- selection ------------------------------------------------------------
+    def _on_selection_changed(self, _selected, _deselected) -> None:
+        self._emit_selection()
+
+    def _emit_selection(self) -> None:
+        ids = self.selected_ids()
+        current = ids[0] if ids else None
+        if current != self._selected:
+            self._selected = current
+            self.selection_changed.emit(current)
+
+    def select(self, node_id: str | None) -> None:
+        for node in self.graph.selected_nodes():
+            node.set_property("selected", False, push_undo=False)
+        node = self._by_id.get(node_id) if node_id else None
+        if node is not None:
+            node.set_property("selected", True, push_undo=False)
+        self._emit_selection()
+
+    def fit_view(self, margin: float = 40.0, min_zoom: float = 0.6) -> None:
+        """Zoom to show every node, between `min_zoom` (text stays readable) and 1:1."""
+        views = [n.view for n in self._by_id.values()]
+        viewer = self.graph.viewer()
+        if not views:
+            return
+        rect = views[0].sceneBoundingRect()
+        for v in views[1:]:
+            rect = rect.united(v.sceneBoundingRect())
+        rect = rect.adjusted(-margin, -margin, margin, margin)
+        size = viewer.viewport().size()
+        w, h = max(size.width(), 50), max(size.height(), 50)
+        scale = min(w / rect.width(), h / rect.height())
+        scale = min(1.0, max(min_zoom, scale))
+        centre = rect.center()
+        rect = QtCore.QRectF(0, 0, w / scale, h / scale)
+        rect.moveCenter(centre)
+        # NodeGraphQt keeps its zoom as a scene range fitted into the view.
+        viewer._scene_range = rect
+        viewer._update_scene()
+
+    # -- gestures -> commands ---------------------------------------------------
+    def _push(self, command) -> bool:
+        try:
+            self.undo.push(command)
+        except (GraphError, KeyError) as exc:
+            msg = exc.args[0] if isinstance(exc, KeyError) else str(exc)
+            self.message.emit("error", f"refused: {msg}")
+            return False
+        return True
+
+    def _edge_from_views(self, a, b) -> Edge | None:
+        out, inp = (a, b) if a.port_type == PortTypeEnum.OUT.value else (b, a)
+        src, dst = self._id_of.get(out.node.id), self._id_of.get(inp.node.id)
+        if src is None or dst is None:
+            return None
+        return Edge(src, out.name, dst, inp.name)
+
+    def gesture_connections(self, disconnected, connected) -> None:
+        commands = []
+        for a, b in disconnected:
+            e = self._edge_from_views(a, b)
+            if e is not None and e in self.doc.edges:
+                commands.append(Disconnect(e.src, e.src_port, e.dst, e.dst_port))
+        for a, b in connected:
+            e = self._edge_from_views(a, b)
+            if e is not None:
+                commands.append(Connect(e.src, e.src_port, e.dst, e.dst_port))
+        if commands:
+            cmd = commands[0] if len(commands) == 1 else Macro(
+                "connect" if any(isinstance(c, Connect) for c in commands) else "disconnect", commands)
+            self._push(cmd)
+        self.sync_edges()
+
+    def connect_ports(self, src: str, src_port: str, dst: str, dst_port: str) -> bool:
+        """The same path as dragging a pipe from src.src_port to dst.dst_port."""
+        s, d = self._by_id[src], self._by_id[dst]
+        out, inp = s.outputs().get(src_port), d.inputs().get(dst_port)
+        if out is None or inp is None:
+            self.message.emit("error", f"refused: no port {src}.{src_port} or {dst}.{dst_port}")
+            return False
+        before = len(self.doc.edges)
+        displaced = [(inp.view, p.view) for p in inp.connected_ports()] if not inp.view.multi_connection else []
+        self.gesture_connections(displaced, [(out.view, inp.view)])
+        return len(self.doc.edges) >= before and Edge(src, src_port, dst, dst_port) in self.doc.edges
+
+    def gesture_moved(self, node_data: dict) -> None:
+        commands = []
+        for view, _prev in node_data.items():
+            nid = self._id_of.get(view.id)
+            if nid is None or nid not in self.doc.nodes:
+                continue
+            x, y = view.xy_pos
+            if tuple(self.doc.nodes[nid].position) != (float(x), float(y)):
+                commands.append(MoveNode(nid, (x, y)))
+        if commands:
+            self._push(commands[0] if len(commands) == 1 else Macro("move nodes", commands))
+
+    def gesture_create(self, scene_type: str, pos) -> None:
+        type_name = self._engine_type_of.get(scene_type)
+        if type_name is not None:
+            self.create_node(type_name, pos)
+
+    def create_node(self, type_name: str, pos=None) -> str | None:
+        """Add a node of `type_name` at scene position `pos`; returns its id."""
+        if pos is None:
+            pos = self.graph.cursor_pos()
+        cmd = AddNode(type_name, {}, position=(float(pos[0]), float(pos[1])))
+        if self._push(cmd):
+            self.select(cmd.node_id)
+            return cmd.node_id
+        return None
+
+    def gesture_rename(self, scene_id: str, name: str) -> None:
+        nid = self._id_of.get(scene_id)
+        if nid is None:
+            return
+        label = name.split("  ·  ")[0].strip()
+        cls = all_node_types()[self.doc.nodes[nid].type_name]
+        if label == (cls.title or cls.type_name):
+            label = ""
+        if label != self.doc.nodes[nid].label:
+            self._push(SetLabel(nid, label))
+        node = self._by_id[nid]
+        node.set_property("name", self._display_name(nid), push_undo=False)
+
+    def gesture_delete(self, scene_ids: list[str]) -> None:
+        ids = [self._id_of[s] for s in scene_ids if s in self._id_of]
+        self.delete_nodes(ids)
+
+    def delete_nodes(self, node_ids: list[str]) -> None:
+        ids = [n for n in node_ids if n in self.doc.nodes]
+        if not ids:
+            return
+        commands = [RemoveNode(n) for n in ids]
+        self._push(commands[0] if len(commands) == 1 else Macro(f"remove {len(ids)} nodes", commands))
+
+    def delete_selected(self) -> None:
+        self.delete_nodes(self.selected_ids())
+
+
+def _html_escape(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")

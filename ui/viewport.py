@@ -1,0 +1,253 @@
+"""3D viewport: the current solid (optionally tiled 3x3x3), its skeleton and the unit cell.
+
+A thin adapter over a pyvistaqt `QtInteractor`; everything here runs on the
+GUI thread.  `pick_display_nodes` decides, from an evaluation's outputs,
+which node's solid and which skeleton to show; it is plain Python.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+from pyvistaqt import QtInteractor
+from PySide6 import QtWidgets
+
+from engine.graph import GraphDocument
+from engine.graph.values import Skeleton, Solid, VoxelModel
+
+SOLID_COLOUR = "#d8cfc0"
+LINE_COLOUR = "#4696dc"
+POINT_COLOUR = "#e8b03c"
+SURFACE_COLOUR = "#6aa8e0"
+BOX_COLOUR = "#8a9099"
+
+
+# -- what to show ------------------------------------------------------------------
+def solid_of(outputs: dict) -> Solid | None:
+    """The Solid among a node's outputs (a VoxelModel carries one too)."""
+    for value in outputs.values():
+        if isinstance(value, Solid):
+            return value
+    for value in outputs.values():
+        if isinstance(value, VoxelModel):
+            return value.solid
+    return None
+
+
+def skeleton_of(outputs: dict) -> Skeleton | None:
+    for value in outputs.values():
+        if isinstance(value, Skeleton):
+            return value
+    return None
+
+
+def _upstream_with(doc: GraphDocument, start: str, outputs: dict, test) -> str | None:
+    """Nearest node above `start` (breadth first, inputs in connection order) whose outputs pass `test`."""
+    seen, frontier = {start}, [start]
+    while frontier:
+        nxt = []
+        for nid in frontier:
+            for e in doc.inputs_of(nid):
+                if e.src in seen:
+                    continue
+                seen.add(e.src)
+                if e.src in outputs and test(outputs[e.src]) is not None:
+                    return e.src
+                nxt.append(e.src)
+        frontier = nxt
+    return None
+
+
+def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None = None
+                       ) -> tuple[str | None, str | None]:
+    """(solid node id, skeleton node id) to display.
+
+    The selected node's solid if it has one; otherwise the solid feeding the
+    Voxel node, else the last solid in topological order.  The skeleton is
+    the selected node's if it is a skeleton node, else the nearest skeleton
+    above the shown solid.
+    """
+    outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
+    solid_id = skel_id = None
+    if selected in outputs:
+        if solid_of(outputs[selected]) is not None:
+            solid_id = selected
+        elif skeleton_of(outputs[selected]) is not None:
+            skel_id = selected
+    if solid_id is None:
+        for nid, inst in doc.nodes.items():
+            if inst.type_name == "Voxel":
+                feeders = [e.src for e in doc.inputs_of(nid) if e.src in outputs]
+                if feeders and solid_of(outputs[feeders[0]]) is not None:
+                    solid_id = feeders[0]
+                    break
+    if solid_id is None:
+        try:
+            order = doc.topological_order()
+        except Exception:
+            order = list(doc.nodes)
+        for nid in reversed(order):
+            if nid in outputs and doc.nodes[nid].type_name != "Voxel" and solid_of(outputs[nid]) is not None:
+                solid_id = nid
+                break
+    if skel_id is None and solid_id is not None:
+        skel_id = _upstream_with(doc, solid_id, outputs, skeleton_of)
+    return solid_id, skel_id
+
+
+# -- geometry helpers ------------------------------------------------------------------
+def tile_offsets(tiles: int, cell_size: float) -> np.ndarray:
+    """(tiles**3, 3) translations placing the original cell in the middle."""
+    r = np.arange(tiles) - (tiles - 1) // 2
+    grid = np.stack(np.meshgrid(r, r, r, indexing="ij"), axis=-1).reshape(-1, 3)
+    return grid.astype(float) * cell_size
+
+
+def tiled_arrays(vertices: np.ndarray, faces: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Translated copies of one mesh, concatenated: ((k*n, 3), (k*m, 3))."""
+    n = len(vertices)
+    v = (vertices[None, :, :] + offsets[:, None, :]).reshape(-1, 3)
+    f = (faces[None, :, :] + (np.arange(len(offsets)) * n)[:, None, None]).reshape(-1, 3)
+    return v, f
+
+
+def polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
+    faces = np.asarray(faces, dtype=np.int64)
+    cells = np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
+    return pv.PolyData(np.asarray(vertices, dtype=float), cells)
+
+
+class Viewport(QtWidgets.QWidget):
+    """Shows a Solid (tiled 1x1x1 or 3x3x3), a Skeleton and the unit-cell box."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        layout = QtWidgets.QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        self.plotter = QtInteractor(self)
+        layout.addWidget(self.plotter.interactor)
+        self.plotter.set_background("#1d1f23", top="#3a3f47")
+        self.plotter.add_axes(color="white")
+        self.tiles = 1
+        self.show_skeleton = True
+        self.show_solid = True
+        self.solid: Solid | None = None
+        self.skeleton: Skeleton | None = None
+        self.caption = ""
+        self.skeleton_emphasis = False
+        self._shown_points = 0
+        self._camera_key = None
+        self._closed = False
+        self.redraw()
+
+    # -- state --------------------------------------------------------------------
+    def show_result(self, solid: Solid | None, skeleton: Skeleton | None, caption: str = "",
+                    *, skeleton_emphasis: bool = False) -> None:
+        """Display `solid` and `skeleton` (either may be None); re-renders."""
+        self.solid, self.skeleton, self.caption = solid, skeleton, caption
+        self.skeleton_emphasis = skeleton_emphasis
+        self.redraw()
+
+    def set_tiling(self, tiles: int) -> None:
+        if tiles not in (1, 3):
+            raise ValueError(f"tiling must be 1 or 3 cells per axis, got {tiles}")
+        self.tiles = tiles
+        self.redraw()
+
+    def set_show_skeleton(self, on: bool) -> None:
+        self.show_skeleton = bool(on)
+        self.redraw()
+
+    def set_show_solid(self, on: bool) -> None:
+        self.show_solid = bool(on)
+        self.redraw()
+
+    def mesh_point_count(self) -> int:
+        """Number of solid-mesh points currently shown (all tiles)."""
+        return self._shown_points
+
+    def cell_size(self) -> float:
+        return float(self.solid.cell_size) if self.solid is not None else 1.0
+
+    # -- drawing --------------------------------------------------------------------
+    def redraw(self) -> None:
+        if self._closed:
+            return
+        p = self.plotter
+        p.clear_actors()
+        self._shown_points = 0
+        c = self.cell_size()
+        offsets = tile_offsets(self.tiles, c)
+        if self.show_solid and self.solid is not None and len(self.solid.faces):
+            v, f = tiled_arrays(self.solid.vertices, self.solid.faces, offsets)
+            mesh = polydata(v, f)
+            translucent = self.show_skeleton and self.skeleton is not None and self.skeleton_emphasis
+            p.add_mesh(mesh, color=SOLID_COLOUR, smooth_shading=True, specular=0.25, name="solid",
+                       opacity=0.35 if translucent else 1.0)
+            self._shown_points = int(mesh.n_points)
+        if self.show_skeleton and self.skeleton is not None:
+            self._draw_skeleton(self.skeleton, c)
+        self._draw_cell_boxes(c)
+        if self.caption:
+            p.add_text(self.caption, position="upper_left", font_size=9, color="white", name="caption")
+        if self.solid is None and self.skeleton is None:
+            p.add_text("nothing to show yet: evaluate a graph with a solid or skeleton node",
+                       position="lower_left", font_size=9, color="#9aa0a6", name="hint")
+        key = (self.tiles, round(c, 9))
+        if key != self._camera_key:
+            self._camera_key = key
+            self._home_camera()
+        p.render()
+
+    def _home_camera(self) -> None:
+        # Slightly off the cube diagonal: the exact isometric view hides
+        # struts along (1, 1, 1), which lattices are full of.
+        self.plotter.view_vector((1.0, -1.7, 0.8), viewup=(0.0, 0.0, 1.0))
+        self.plotter.reset_camera()
+
+    def _draw_skeleton(self, skeleton: Skeleton, c: float) -> None:
+        p = self.plotter
+        controls = []
+        for i, line in enumerate(skeleton.lines):
+            if len(line.polyline) >= 2:
+                p.add_mesh(pv.lines_from_points(line.polyline * c), color=LINE_COLOUR, line_width=4,
+                           render_lines_as_tubes=True, name=f"line{i}")
+            controls.append(line.control_points * c)
+        for i, surf in enumerate(skeleton.surfaces):
+            if len(surf.faces):
+                p.add_mesh(polydata(surf.vertices * c, surf.faces), color=SURFACE_COLOUR, opacity=0.6,
+                           name=f"surface{i}")
+        if controls:
+            pts = np.concatenate(controls)
+            if len(pts):
+                p.add_mesh(pv.PolyData(pts), color=POINT_COLOUR, point_size=12,
+                           render_points_as_spheres=True, name="control_points")
+
+    def _draw_cell_boxes(self, c: float) -> None:
+        self.plotter.add_mesh(pv.Box(bounds=(0, c, 0, c, 0, c)), style="wireframe", color=BOX_COLOUR,
+                              line_width=1.5, name="cell_box")
+        if self.tiles > 1:
+            lo, hi = -c * ((self.tiles - 1) // 2), c * (1 + (self.tiles - 1) // 2)
+            self.plotter.add_mesh(pv.Box(bounds=(lo, hi, lo, hi, lo, hi)), style="wireframe",
+                                  color="#5a6068", line_width=1.0, name="tiling_box")
+
+    def reset_camera(self) -> None:
+        self._home_camera()
+        self.plotter.render()
+
+    # -- output -------------------------------------------------------------------------
+    def save_screenshot(self, path: str | Path) -> Path:
+        """Render and write the view as a PNG; returns the path."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.plotter.render()
+        self.plotter.screenshot(str(path))
+        return path
+
+    def close_plotter(self) -> None:
+        """Release the render window (must happen before the widget goes)."""
+        if not self._closed:
+            self._closed = True
+            self.plotter.close()
