@@ -12,14 +12,15 @@ from ui.main_window import DEFAULT_EXAMPLE, EXAMPLES_DIR, MainWindow, Prompter
 
 def create_main_window(project_path: str | Path | None = None, autosave_dir: str | Path | None = None, *,
                        prompter: Prompter | None = None, open_example: bool = False,
-                       offer_recovery: bool = False) -> MainWindow:
+                       offer_recovery: bool = False, autosave_interval_ms: int | None = None) -> MainWindow:
     """A MainWindow (a QApplication must exist) with `project_path` opened.
 
     Without a project, ``open_example=True`` loads the default example
     (``resources/examples/octet.json``) when it is present.  With
     ``offer_recovery=True`` a crashed session's autosave is offered first.
     """
-    window = MainWindow(autosave_dir=autosave_dir, prompter=prompter)
+    extra = {} if autosave_interval_ms is None else {"autosave_interval_ms": autosave_interval_ms}
+    window = MainWindow(autosave_dir=autosave_dir, prompter=prompter, **extra)
     if offer_recovery and window.offer_recovery():
         return window
     if project_path is not None:

@@ -49,7 +49,7 @@ OBJECT_RESOLUTION = 96          # Object node grid, as in the paper's examples
 MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}   # paper section 8.2
 CENTRE = [0.5, 0.5, 0.5]
 BODY_DIAGONAL = [1.0, 1.0, 1.0]
-SPHERE_SEED = 0.002             # length of the short segment that stands in for a sphere
+SPHERE_SEED = 0.0               # a zero-length line: spherically thickened, a sphere (paper 3.1)
 
 COLUMN_WIDTH = 250.0
 ROW_HEIGHT = 110.0
@@ -189,7 +189,7 @@ class GraphBuilder:
 
     def document(self) -> GraphDocument:
         doc = GraphDocument(seed=0)
-        doc.meta = dict(self.meta, node_count=len(self._nodes))
+        doc.meta = dict(self.meta)
         stack = UndoStack(doc)
         pos = self.positions()
         types = {n[0]: n[1] for n in self._nodes}
@@ -432,7 +432,7 @@ def assembled3() -> GraphBuilder:
 
 
 def twist_tilable() -> GraphBuilder:
-    inset, radius = 0.1, 0.14
+    inset, radius = 0.1, 0.17
     face_c = [0.5, 0.5, inset]
     corner = [inset, inset, inset]
     # Tangent point on the ring seen from the face corner (at 225 degrees):
@@ -473,28 +473,35 @@ def twist_tilable() -> GraphBuilder:
 
 
 def six_hole_bcc() -> GraphBuilder:
-    outer, inner, hole = 0.94, 0.82, 0.28
+    outer, inner, hole, neck = 0.80, 0.68, 0.24, 0.14
     b = GraphBuilder(
         "six_hole_bcc", title="6-hole BCC bucklicrystal", source="after Babaee et al. 2013, '3D soft "
         "metamaterials with negative Poisson's ratio' (6-hole building block, BCC)", paper_nodes=27,
-        description="Spherical shells on the BCC sites, each pierced by six holes along the axes; "
-                    "neighbouring shells fuse where they overlap along the body diagonals. Built by "
-                    "CSG: outer balls minus inner balls gives the shells, minus the axis cylinders "
-                    "gives the holes.")
-    centre = b.vertex("v_corner", [0, 0, 0])
+        description="Spherical shells on the BCC sites, each pierced by six holes along the axes and "
+                    "joined to its eight neighbours by short necks along the body diagonals. Built "
+                    "by CSG: (balls + necks) minus inner balls gives the joined shells, minus the "
+                    "axis cylinders gives the holes.")
+    corner = b.vertex("v_corner", [0, 0, 0])
     seed = b.vertex("v_sphere_seed", [SPHERE_SEED, 0, 0])
+    centre = b.vertex("v_centre", CENTRE)
     axis_end = b.vertex("v_axis_end", [1, 0, 0])
-    e_ball = b.chain("e_sphere", [centre, seed])
-    e_axis = b.chain("e_axis_x", [centre, axis_end])
+    e_ball = b.chain("e_sphere", [corner, seed])
+    e_neck = b.chain("e_neck", [corner, centre])
+    e_axis = b.chain("e_axis_x", [corner, axis_end])
     l_outer = b.line("l_outer_sphere", [e_ball], [[0, outer], [1, outer]])
     l_inner = b.line("l_inner_sphere", [e_ball], [[0, inner], [1, inner]])
+    l_neck = b.line("l_neck", [e_neck], [[0, neck], [1, neck]])
     l_hole = b.line("l_hole", [e_axis], [[0, hole], [1, hole]])
     bc = dict(translation=[0.5, 0.5, 0.5])
     outers = b.transform("outer_body_centring", l_outer, **bc)
     inners = b.transform("inner_body_centring", l_inner, **bc)
+    necks = b.mirror("neck_mirror_x", l_neck, [1, 0, 0])
+    necks = b.mirror("neck_mirror_y", necks, [0, 1, 0])
+    necks = b.mirror("neck_mirror_z", necks, [0, 0, 1])
+    balls = b.group("balls_and_necks", [outers, necks])
     axes = b.threefold("holes", l_hole)
     holes = b.transform("holes_body_centring", axes, **bc)
-    o_outer = b.object("object_outer", outers)
+    o_outer = b.object("object_outer", balls)
     o_inner = b.object("object_inner", inners)
     o_holes = b.object("object_holes", holes, extrusion="normal")
     shells = b.csg("shells", [o_outer, o_inner], "difference")

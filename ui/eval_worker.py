@@ -22,11 +22,12 @@ class _EvalThread(QtCore.QThread):
     node_done = QtCore.Signal(object)
     report_ready = QtCore.Signal(object)
 
-    def __init__(self, evaluator: Evaluator, snapshot: GraphSnapshot, token: CancelToken, parent=None):
+    def __init__(self, evaluator: Evaluator, snapshot: GraphSnapshot, token: CancelToken, tag=None, parent=None):
         super().__init__(parent)
         self._evaluator = evaluator
         self._snapshot = snapshot
         self.token = token
+        self.tag = tag
 
     def run(self) -> None:
         try:
@@ -62,7 +63,7 @@ class EvalWorker(QtCore.QObject):
         super().__init__(parent)
         self.evaluator = evaluator or Evaluator()
         self._thread: _EvalThread | None = None
-        self._pending: GraphSnapshot | None = None
+        self._pending: tuple[GraphSnapshot, object] | None = None
         self._request_no = 0
         self.last_report: EvalReport | None = None
         self.superseded = False  # the running evaluation was cancelled by a newer request
@@ -75,9 +76,12 @@ class EvalWorker(QtCore.QObject):
     def is_busy(self) -> bool:
         return self._thread is not None or self._pending is not None
 
-    def request(self, snapshot: GraphSnapshot) -> None:
-        """Evaluate `snapshot`; a running evaluation is cancelled and this one follows it."""
-        self._pending = snapshot
+    def request(self, snapshot: GraphSnapshot, tag=None) -> None:
+        """Evaluate `snapshot`; a running evaluation is cancelled and this one follows it.
+
+        `tag` comes back as ``report.tag`` (the window uses it to drop reports
+        of a document it has since replaced)."""
+        self._pending = (snapshot, tag)
         if self._thread is not None:
             self.superseded = True
             self._thread.token.cancel()
@@ -92,13 +96,14 @@ class EvalWorker(QtCore.QObject):
             self._thread.token.cancel()
 
     def _start_pending(self) -> None:
-        snapshot, self._pending = self._pending, None
-        if snapshot is None:
+        pending, self._pending = self._pending, None
+        if pending is None:
             self.busy_changed.emit(False)
             return
+        snapshot, tag = pending
         self._request_no += 1
         self.superseded = False
-        thread = _EvalThread(self.evaluator, snapshot, CancelToken(), self)
+        thread = _EvalThread(self.evaluator, snapshot, CancelToken(), tag, self)
         thread.progress.connect(self.progress)
         thread.node_done.connect(self.node_done)
         thread.report_ready.connect(self._on_report)
@@ -113,6 +118,7 @@ class EvalWorker(QtCore.QObject):
         thread, self._thread = self._thread, None
         if thread is not None:
             thread.wait()  # run() has returned; this only joins the OS thread
+        report.tag = thread.tag if thread is not None else None
         report.superseded = bool(report.cancelled and self.superseded and self._pending is not None)
         self.last_report = report
         self.finished.emit(report)

@@ -110,6 +110,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._eval_total = 0
         self._eval_done: list[NodeResult] = []
         self._shutting_down = False
+        self._generation = 0  # bumped whenever the document is replaced (new / open / recover)
 
         self.worker = EvalWorker(parent=self)
         self.autosave = AutosaveManager(autosave_dir)
@@ -217,6 +218,7 @@ class MainWindow(QtWidgets.QMainWindow):
                                          checked=True)
         self.act_solid = self._action("Show S&olid", self.viewport.set_show_solid, checkable=True, checked=True)
         self.act_fit = self._action("Fit Node Graph", self.editor.fit_view, "F")
+        self.act_arrange = self._action("Arrange Nodes", self.editor.arrange_nodes, "Ctrl+L")
         self.act_reset_camera = self._action("Reset Camera", self.viewport.reset_camera, "R")
         self.act_evaluate = self._action("&Evaluate Now", self.evaluate_now, "F5")
         self.act_auto = self._action("&Auto-evaluate", self._on_auto_toggled, checkable=True, checked=True)
@@ -259,6 +261,7 @@ class MainWindow(QtWidgets.QMainWindow):
         view_menu.addAction(self.act_solid)
         view_menu.addSeparator()
         view_menu.addAction(self.act_fit)
+        view_menu.addAction(self.act_arrange)
         view_menu.addAction(self.act_reset_camera)
         view_menu.addSeparator()
         for dock in (self.editor_dock, self.inspector_dock, self.log_dock):
@@ -349,7 +352,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.log("error", f"cannot evaluate: {exc}")
             return
         self._eval_total = len(snapshot.nodes)
-        self.worker.request(snapshot)
+        self.worker.request(snapshot, tag=self._generation)
 
     def cancel_evaluation(self) -> None:
         self._debounce.stop()
@@ -384,6 +387,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cancel_button.setEnabled(self.worker.is_busy)
         if getattr(report, "superseded", False):
             return  # a newer snapshot is already being evaluated
+        if getattr(report, "tag", self._generation) != self._generation:
+            return  # belongs to a document that has been replaced since
         internal = getattr(report, "internal_error", "")
         if internal:
             self.log("error", f"evaluation failed: {internal}")
@@ -437,6 +442,7 @@ class MainWindow(QtWidgets.QMainWindow):
     # -- files ---------------------------------------------------------------------------------
     def _replace_document(self, new_doc: GraphDocument, path: Path | None, name: str) -> None:
         self.worker.cancel()
+        self._generation += 1
         self.last_report = None
         self.doc.replace_with(new_doc)
         self.undo.clear()

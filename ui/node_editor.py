@@ -217,6 +217,7 @@ class NodeEditor(QtWidgets.QWidget):
                                 lambda _graph, _name=name: self.create_node(_name, self.menu_scene_pos))
         menu.add_separator()
         menu.add_command("Delete selected", lambda _graph: self.delete_selected())
+        menu.add_command("Arrange nodes", lambda _graph: self.arrange_nodes())
         menu.add_command("Fit view", lambda _graph: self.fit_view())
 
     def detach(self) -> None:
@@ -414,6 +415,39 @@ class NodeEditor(QtWidgets.QWidget):
         # NodeGraphQt keeps its zoom as a scene range fitted into the view.
         viewer._scene_range = rect
         viewer._update_scene()
+
+    def arrange_nodes(self, *, column_width: float = 240.0, row_height: float = 100.0,
+                      columns: int | None = None) -> bool:
+        """Lay the graph out in columns by depth, wrapping into bands that fit the
+        editor's width; one undoable "arrange nodes" step.  False if nothing moved."""
+        try:
+            order = self.doc.topological_order()
+        except GraphError:
+            return False
+        depth: dict[str, int] = {}
+        for nid in order:
+            depth[nid] = max((depth[e.src] + 1 for e in self.doc.inputs_of(nid) if e.src in depth), default=0)
+        if columns is None:
+            width = self.graph.viewer().viewport().width() / 0.8
+            columns = max(2, int(width // column_width))
+        levels: dict[int, list[str]] = {}
+        for nid in order:
+            levels.setdefault(depth[nid], []).append(nid)
+        positions, top = {}, 0.0
+        n_levels = max(levels, default=-1) + 1
+        for band_start in range(0, n_levels, columns):
+            band = [levels.get(d, []) for d in range(band_start, min(band_start + columns, n_levels))]
+            for k, ids in enumerate(band):
+                for r, nid in enumerate(ids):
+                    positions[nid] = (k * column_width, top + r * row_height)
+            top += max(len(ids) for ids in band) * row_height + 0.6 * row_height
+        moves = [MoveNode(nid, pos) for nid, pos in positions.items()
+                 if tuple(self.doc.nodes[nid].position) != pos]
+        if not moves:
+            return False
+        ok = self._push(Macro("arrange nodes", moves))
+        self.fit_view()
+        return ok
 
     # -- gestures -> commands ---------------------------------------------------
     def _push(self, command) -> bool:

@@ -6,6 +6,7 @@ Returning ``False`` asks the kernel to stop; it then raises :class:`Cancelled`.
 
 from __future__ import annotations
 
+import threading
 import time
 from typing import Callable, Optional
 
@@ -14,6 +15,13 @@ ProgressFn = Optional[Callable[[int, int], bool]]
 # A chunk of work between two progress calls should take about this long, so
 # that a cancel request is honoured well within the ~100 ms the UI promises.
 TARGET_CHUNK_SECONDS = 0.04
+
+
+# numba's "workqueue" threading layer (the fallback when neither TBB nor
+# OpenMP is available) aborts the process if two threads launch parallel
+# kernels at once; the UI may evaluate nodes from several worker threads.
+# Work chunks are short, so serialising them costs little.
+_PARALLEL_LOCK = threading.Lock()
 
 
 class Cancelled(Exception):
@@ -46,7 +54,7 @@ def run_chunked(work: Callable[[int, int], None], total: int,
     Without a callback the whole range is done in one call (least overhead).
     With one, the chunk size adapts so each call lasts about
     ``TARGET_CHUNK_SECONDS``; the callback is consulted before and after
-    each chunk.
+    each chunk. Calls to ``work`` from different threads never overlap.
 
     Parameters
     ----------
@@ -60,15 +68,17 @@ def run_chunked(work: Callable[[int, int], None], total: int,
         Size of the first, timing, chunk.
     """
     if progress is None:
-        work(0, total)
+        with _PARALLEL_LOCK:
+            work(0, total)
         return
     report(progress, 0, total)
     start, chunk = 0, max(1, first_chunk)
     while start < total:
         stop = min(total, start + chunk)
-        t0 = time.perf_counter()
-        work(start, stop)
-        elapsed = time.perf_counter() - t0
+        with _PARALLEL_LOCK:
+            t0 = time.perf_counter()
+            work(start, stop)
+            elapsed = time.perf_counter() - t0
         start = stop
         report(progress, start, total)
         # Grow or shrink towards the target, but never by more than 4x at a

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["periodic_mesh", "boundary_section_match", "solid_volume_fraction",
+__all__ = ["periodic_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
            "mesh_volume_fraction", "mesh_volume"]
 
 
@@ -63,10 +63,15 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     Samples within a relative 1e-7 of ``level`` are nudged off it: marching
     cubes would otherwise place several vertices at the same grid node and
     downstream vertex merging would break the watertight topology.
+    Caps: crossings into the outside pad layer are clipped onto the box
+    faces; where that makes vertices coincide (box edges and corners) they
+    are welded and the collapsed triangles dropped.
+    Memory: the tiled grid is float32 with ``(N * tiles + 3)`` samples per
+    axis (about 230 MB for N = 128 and 3 x 3 x 3 tiles) plus the mesh.
     """
     from skimage.measure import marching_cubes
 
-    f = _check_field(field).astype(np.float64)
+    f = _check_field(field)
     lv = _check_level(level)
     try:
         t = tuple(int(x) for x in tiles)
@@ -78,28 +83,100 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     if not np.isfinite(cs) or cs <= 0:
         raise ValueError(f"cell_size must be a finite length > 0; got {cell_size!r}")
 
-    spread = float(np.abs(f - lv).max())
-    eps = 1e-7 * max(spread, 1e-30)
-    near = np.abs(f - lv) < eps
-    f[near] = np.where(f[near] < lv, lv - eps, lv + eps)
-
-    grid = np.pad(np.tile(f, t), [(0, 1)] * 3, mode="wrap")
-    offset = 0
-    if closed:
-        # A layer of clearly-outside samples all round closes the surface;
-        # the crossings it creates are clipped back onto the box faces below.
-        grid = np.pad(grid, 1, mode="constant", constant_values=lv + 10.0 * (spread + 1.0))
-        offset = 1
-    if not ((grid < lv).any() and (grid > lv).any()):
+    # scikit-image works in float32; do the nudging there so it survives.
+    f = f.astype(np.float32)
+    lv32 = np.float32(lv)
+    spread = float(np.abs(f - lv32).max())
+    eps = np.float32(max(1e-7 * spread, 4.0 * float(np.spacing(np.abs(lv32))), 1e-30))
+    near = np.abs(f - lv32) < eps
+    f[near] = np.where(f[near] < lv32, lv32 - eps, lv32 + eps)
+    if not ((f < lv32).any() and ((f > lv32).any() or closed)):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
 
-    verts, faces, _, _ = marching_cubes(grid, level=lv, gradient_direction="descent",
+    # Tile and append the wrap sample in one gather; with ``closed`` the
+    # grid gets a layer of clearly-outside samples all round, whose
+    # crossings are clipped back onto the box faces below.
+    pad = 1 if closed else 0
+    axes = [np.arange(f.shape[a] * t[a] + 1) % f.shape[a] for a in range(3)]
+    grid = np.full([len(ax) + 2 * pad for ax in axes], lv32 + np.float32(10.0 * (spread + 1.0)),
+                   dtype=np.float32)
+    inner = tuple(slice(pad, grid.shape[a] - pad) for a in range(3))
+    grid[inner] = f[np.ix_(*axes)]
+
+    verts, faces, _, _ = marching_cubes(grid, level=float(lv32), gradient_direction="descent",
                                         allow_degenerate=True)
     spacing = cs / np.array(f.shape, dtype=np.float64)
     extent = cs * np.array(t, dtype=np.float64)
-    verts = (verts.astype(np.float64) - offset) * spacing
-    verts = np.clip(verts, 0.0, extent)
-    return verts, faces.astype(np.int64)
+    verts = (verts.astype(np.float64) - pad) * spacing
+    faces = faces.astype(np.int64)
+    if closed:
+        verts = np.clip(verts, 0.0, extent)
+        verts, faces = _weld_clipped(verts, faces, extent)
+        verts, faces = drop_specks(verts, faces, 0.5 * float(np.prod(spacing)))
+    return verts, faces
+
+
+def drop_specks(vertices, faces, min_volume):
+    """Remove closed pieces enclosing less than ``min_volume`` (absolute).
+
+    Where two rounded solids meet in a sharp concave crease, single grid
+    nodes can be trapped just outside both; marching cubes then emits
+    sub-voxel void bubbles (or solid specks) that are closed but carry no
+    real geometry.  Whole closed pieces are dropped, so a watertight mesh
+    stays watertight.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if f.shape[0] == 0:
+        return v, f
+    n = v.shape[0]
+    rows = np.concatenate([f[:, 0], f[:, 1], f[:, 2]])
+    cols = np.concatenate([f[:, 1], f[:, 2], f[:, 0]])
+    adj = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
+    count, label = connected_components(adj, directed=False)
+    if count == 1:
+        return v, f
+    tri = v[f]
+    vol6 = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
+    piece_volume = np.abs(np.bincount(label[f[:, 0]], weights=vol6, minlength=count)) / 6.0
+    keep_face = piece_volume[label[f[:, 0]]] >= min_volume
+    if keep_face.all():
+        return v, f
+    f = f[keep_face]
+    used = np.zeros(n, dtype=bool)
+    used[f.ravel()] = True
+    return v[used], (np.cumsum(used) - 1)[f]
+
+
+def _weld_clipped(verts, faces, extent):
+    """Merge vertices that clipping made identical; drop collapsed triangles.
+
+    A node on a box edge (corner) has two (three) pad neighbours; the
+    crossings towards them all clip onto that node. They are joined by
+    surface edges, so welding them is an edge collapse of a thin strip of
+    the cap, which keeps the surface closed and manifold; the triangles
+    that collapse to zero area (repeated index) are removed. Only vertices
+    on box edges can coincide, so only those are compared.
+    """
+    on_box = ((verts == 0.0) | (verts == extent)).sum(axis=1) >= 2
+    cand = np.flatnonzero(on_box)
+    if cand.size < 2:
+        return verts, faces
+    _, first, inverse = np.unique(verts[cand], axis=0, return_index=True, return_inverse=True)
+    if first.size == cand.size:
+        return verts, faces
+    remap = np.arange(verts.shape[0])
+    remap[cand] = cand[first][inverse.ravel()]
+    faces = remap[faces]
+    keep = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
+    faces = faces[keep]
+    used = np.zeros(verts.shape[0], dtype=bool)
+    used[faces.ravel()] = True
+    new_index = np.cumsum(used) - 1
+    return verts[used], new_index[faces]
 
 
 def mesh_volume(vertices, faces):

@@ -1,9 +1,7 @@
 """Mesh export / import for the Object node (STL, OBJ, PLY, 3MF).
 
-STL, OBJ and PLY go through trimesh. trimesh's 3MF writer needs ``lxml``,
-which is not a dependency here, so 3MF is written and read by a small
-stdlib (zipfile + ElementTree) implementation of the 3MF core spec: one mesh
-object, units in millimetres.
+All four formats go through trimesh (3MF needs lxml and networkx, which are
+dependencies for that reason).
 
 Every export is atomic: the file is written to a temporary sibling, fsynced
 and renamed over the target, so a crash never leaves a truncated mesh.
@@ -11,35 +9,15 @@ and renamed over the target, so a crash never leaves a truncated mesh.
 
 from __future__ import annotations
 
-import io
-import os
-import tempfile
-import zipfile
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
 import numpy as np
+
+from engine.fileio import write_atomic
 
 __all__ = ["export_mesh", "load_mesh", "mesh_summary", "SUPPORTED_SUFFIXES"]
 
 SUPPORTED_SUFFIXES = (".stl", ".obj", ".ply", ".3mf")
-
-_NS_3MF = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
-_CONTENT_TYPES = (
-    '<?xml version="1.0" encoding="UTF-8"?>\n'
-    '<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">'
-    '<Default Extension="rels" '
-    'ContentType="application/vnd.openxmlformats-package.relationships+xml"/>'
-    '<Default Extension="model" '
-    'ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>'
-    '</Types>')
-_RELS = (
-    '<?xml version="1.0" encoding="UTF-8"?>\n'
-    '<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">'
-    '<Relationship Target="/3D/3dmodel.model" Id="rel0" '
-    'Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>'
-    '</Relationships>')
-
 
 def _suffix(path):
     suffix = Path(path).suffix.lower()
@@ -63,80 +41,6 @@ def _check_mesh(vertices, faces):
     return v, f
 
 
-def _threemf_bytes(v, f):
-    lines = [f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" '
-             f'xml:lang="en-US" xmlns="{_NS_3MF}"><resources><object id="1" type="model">'
-             '<mesh><vertices>']
-    lines += [f'<vertex x="{x:.10g}" y="{y:.10g}" z="{z:.10g}"/>' for x, y, z in v.tolist()]
-    lines.append('</vertices><triangles>')
-    lines += [f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in f.tolist()]
-    lines.append('</triangles></mesh></object></resources><build><item objectid="1"/></build></model>')
-    buf = io.BytesIO()
-    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as z:
-        z.writestr("[Content_Types].xml", _CONTENT_TYPES)
-        z.writestr("_rels/.rels", _RELS)
-        z.writestr("3D/3dmodel.model", "\n".join(lines))
-    return buf.getvalue()
-
-
-def _read_threemf(path):
-    """Mesh objects placed by build items (with their transforms), concatenated."""
-    with zipfile.ZipFile(path) as z:
-        name = next((n for n in z.namelist() if n.lower().endswith(".model")), None)
-        if name is None:
-            raise ValueError(f"path {str(path)!r} is not a 3MF package: no .model part")
-        root = ET.fromstring(z.read(name))
-    ns = {"m": root.tag[1:].split("}")[0]} if root.tag.startswith("{") else {"m": ""}
-    q = (lambda tag: f"m:{tag}") if ns["m"] else (lambda tag: tag)
-    meshes = {}
-    for obj in root.iterfind(f"{q('resources')}/{q('object')}", ns):
-        mesh = obj.find(q("mesh"), ns)
-        if mesh is None:
-            raise ValueError(f"path {str(path)!r}: 3MF components are not supported, only meshes")
-        verts = [[float(e.get(k)) for k in "xyz"] for e in mesh.iterfind(f"{q('vertices')}/{q('vertex')}", ns)]
-        tris = [[int(e.get(k)) for k in ("v1", "v2", "v3")]
-                for e in mesh.iterfind(f"{q('triangles')}/{q('triangle')}", ns)]
-        meshes[obj.get("id")] = (np.array(verts, dtype=np.float64).reshape(-1, 3),
-                                 np.array(tris, dtype=np.int64).reshape(-1, 3))
-    all_v, all_f, base = [], [], 0
-    for item in root.iterfind(f"{q('build')}/{q('item')}", ns):
-        v, f = meshes[item.get("objectid")]
-        if item.get("transform"):
-            m = np.array([float(x) for x in item.get("transform").split()]).reshape(4, 3)
-            v = v @ m[:3] + m[3]          # 3MF uses row vectors: p' = p M + t
-        all_v.append(v)
-        all_f.append(f + base)
-        base += v.shape[0]
-    if not all_v:
-        raise ValueError(f"path {str(path)!r}: the 3MF build places no mesh")
-    return np.concatenate(all_v), np.concatenate(all_f)
-
-
-def _atomic_write(path, data):
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    try:  # make the rename itself durable; not possible on every platform
-        dfd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(dfd)
-        finally:
-            os.close(dfd)
-    except OSError:
-        pass
-
-
 def export_mesh(vertices, faces, path):
     """Write a triangle mesh, format chosen by the file suffix.
 
@@ -150,16 +54,14 @@ def export_mesh(vertices, faces, path):
         Ends in .stl (binary), .obj, .ply (binary) or .3mf (any case). The
         directory must exist; an existing file is replaced atomically.
     """
+    import trimesh
+
     suffix = _suffix(path)
     v, f = _check_mesh(vertices, faces)
-    if suffix == ".3mf":
-        data = _threemf_bytes(v, f)
-    else:
-        import trimesh
-        data = trimesh.Trimesh(v, f, process=False).export(file_type=suffix[1:])
-        if isinstance(data, str):
-            data = data.encode("utf-8")
-    _atomic_write(path, data)
+    data = trimesh.Trimesh(v, f, process=False).export(file_type=suffix[1:])
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    write_atomic(path, data)
 
 
 def load_mesh(path):
@@ -178,11 +80,9 @@ def load_mesh(path):
     suffix = _suffix(path)
     if not Path(path).is_file():
         raise ValueError(f"path must be an existing file; got {str(path)!r}")
-    if suffix == ".3mf":
-        v, f = _read_threemf(path)
-        mesh = trimesh.Trimesh(v, f, process=True)
-    else:
-        mesh = trimesh.load_mesh(str(path), file_type=suffix[1:], process=True)
+    mesh = trimesh.load_mesh(str(path), file_type=suffix[1:], process=True)
+    if isinstance(mesh, trimesh.Scene):  # 3MF loads as a scene of placed meshes
+        mesh = mesh.to_mesh() if hasattr(mesh, "to_mesh") else mesh.dump(concatenate=True)
     return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
 
 

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Callable
+
+from engine.fileio import write_atomic
 
 from .document import Edge, GraphDocument, NodeInstance
 from .errors import GraphError, ProjectFileError
@@ -128,33 +129,6 @@ def load_project(path: str | os.PathLike) -> GraphDocument:
         return document_from_dict(data)
     except ValueError as exc:
         raise ProjectFileError(p, str(exc)) from None
-
-
-def write_atomic(path: str | os.PathLike, data: bytes) -> None:
-    """Write bytes so that `path` holds either the old or the new content."""
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, p)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-    try:  # make the rename durable too
-        dfd = os.open(p.parent, os.O_RDONLY)
-        try:
-            os.fsync(dfd)
-        finally:
-            os.close(dfd)
-    except OSError:
-        pass
 
 
 def save_project(doc: GraphDocument, path: str | os.PathLike) -> None:

@@ -83,6 +83,11 @@ class LineNode(NodeType):
         chains = inputs["chains"]
         path = order_chains(chains)
         pieces, controls = [], []
+        if len(path) == 1 and np.ptp(chain_points := path[0][0].points, axis=0).max() < 1e-12:
+            # zero-length line: one point, a sphere under spherical extrusion (paper 3.1)
+            d = thickness_profile(np.zeros(1), params["thickness"])[0]
+            element = LineElement(chain_points[:1].repeat(2, axis=0), np.full(2, d), chain_points[:1])
+            return {"skeleton": Skeleton((element,))}
         for chain, rev in path:
             pts = chain.points[::-1] if rev else chain.points
             period = None if chain.period is None else (-chain.period if rev else chain.period)

@@ -63,7 +63,11 @@ class EdgeChainNode(NodeType):
         if len(body) < 2:
             raise NodeInputError(f"an edge chain needs at least two vertices, got {len(body)}", where="vertices")
         points = np.array([pts[i] for i in body])
-        if np.any(np.linalg.norm(np.diff(points, axis=0), axis=1) < 1e-12):
+        gaps = np.linalg.norm(np.diff(points, axis=0), axis=1) < 1e-12
+        if np.all(gaps) and not closed:
+            # a zero-length chain: thickened spherically it is a sphere (paper 3.1)
+            return {"chain": EdgeChain(points[:1].repeat(2, axis=0), False)}
+        if np.any(gaps):
             raise NodeInputError("two consecutive vertices of the edge chain coincide", where="vertices")
         period = np.array(params["period"])
         return {"chain": EdgeChain(points, bool(params["smooth"]), closed,

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from engine.graph import AddNode, Connect, Disconnect, Edge, RemoveNode, document_to_dict
+import pytest
+
+from engine.graph import AddNode, Connect, Edge, RemoveNode, document_to_dict
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 
 def test_scene_follows_commands_and_undo(window):
@@ -130,3 +134,17 @@ def test_reset_rebuilds_scene(window, strut_graph):
     assert not window.undo.can_undo
     assert window.windowTitle().startswith("untitled")
     assert ids  # graph existed
+
+
+def test_arrange_nodes_is_one_undo_step(window, strut_graph):
+    ids = strut_graph(window.undo)
+    before = {nid: n.position for nid, n in window.doc.nodes.items()}
+    assert window.editor.arrange_nodes(columns=3)
+    after = {nid: n.position for nid, n in window.doc.nodes.items()}
+    assert after[ids["v1"]][0] == after[ids["v2"]][0] == 0.0       # sources share the first column
+    assert after[ids["e"]][0] > after[ids["v1"]][0]
+    assert after[ids["obj"]][1] > after[ids["v1"]][1]               # depth 3 wraps into a second band
+    assert window.editor.scene_node(ids["obj"]).pos() == list(after[ids["obj"]])
+    assert window.undo.undo_text() == "arrange nodes"
+    window.undo_edit()
+    assert {nid: n.position for nid, n in window.doc.nodes.items()} == before

@@ -11,6 +11,8 @@ from app.autosave import AutosaveManager
 from engine.graph import AddNode, SetSeed, document_to_dict
 from ui.main_window import EXAMPLES_DIR
 
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
+
 
 def test_corrupt_project_shows_error_and_keeps_document(window, tmp_path, strut_graph, prompter):
     strut_graph(window.undo)
@@ -99,3 +101,13 @@ def test_examples_menu_lists_examples(window):
         assert names == [p.stem.replace("_", " ") for p in files]
     else:
         assert names == ["(no examples found)"]
+
+
+def test_autosave_timer_writes_only_unsaved_work(make_window, qtbot, tmp_path):
+    window = make_window(autosave_dir=tmp_path / "auto", autosave_interval_ms=50)
+    qtbot.wait(150)
+    assert not window.autosave.autosave_path.exists()     # nothing unsaved: nothing written
+    window.undo.push(SetSeed(9))
+    qtbot.waitUntil(window.autosave.autosave_path.exists, timeout=2000)
+    window.save_as(tmp_path / "p.json")                   # a clean save removes the autosave
+    assert not window.autosave.autosave_path.exists()

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from PySide6 import QtGui
 
 from engine.graph import document_to_dict
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 
 def png_pixels(path) -> np.ndarray:
@@ -130,7 +133,6 @@ def test_screenshot_is_written_and_not_blank(window, tmp_path, strut_graph, wait
 
 
 def test_export_mesh_uses_current_tiling(window, tmp_path, strut_graph, wait_eval):
-    import pytest
     pytest.importorskip("engine.geometry.mesh_io")
     strut_graph(window.undo)
     wait_eval(window, 0)

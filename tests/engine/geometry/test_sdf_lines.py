@@ -176,3 +176,16 @@ def test_no_polylines_gives_an_empty_field():
 def test_bad_input_is_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
         line_sdf_grid(**kwargs)
+
+
+def test_concurrent_calls_from_threads_agree():
+    from concurrent.futures import ThreadPoolExecutor
+    rng = np.random.default_rng(5)
+    polys, radii = _random_polylines(rng, 4, 0.3)
+    expected = line_sdf_grid(polys, radii, resolution=32)
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(
+            lambda k: line_sdf_grid(polys, radii, resolution=32, progress=(lambda d, t: True) if k % 2 else None),
+            range(8)))
+    for r in results:
+        np.testing.assert_array_equal(r, expected)

@@ -151,3 +151,18 @@ def test_voxel_node_carries_material_and_occupancy():
     vm = Evaluator().evaluate(doc).output("vox")
     assert vm.E == 2.0 and vm.nu == 0.3 and vm.occupancy.shape == (40, 40, 40)
     assert vm.volume_fraction == pytest.approx(math.pi * 0.04, rel=0.05)
+
+
+def test_zero_length_line_is_a_sphere():
+    doc, st = _graph()
+    v = _vertices(st, [(0.5, 0.5, 0.5), (0.5, 0.5, 0.5)])
+    _chain(st, v)
+    st.push(AddNode("Line", {"thickness": [[0.0, 0.6]]}, node_id="l"))
+    st.push(Connect("e", "chain", "l", "chains"))
+    st.push(AddNode("Object", {"resolution": 64}, node_id="o"))
+    st.push(Connect("l", "skeleton", "o", "skeleton"))
+    r = Evaluator().evaluate(doc)
+    assert r.ok, r.errors
+    from engine.geometry.mesh_io import mesh_summary
+    s = mesh_summary(r.output("o").vertices, r.output("o").faces)
+    assert s["watertight"] and s["volume"] == pytest.approx(4 / 3 * math.pi * 0.3**3, rel=0.02)
