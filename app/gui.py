@@ -7,7 +7,8 @@ from pathlib import Path
 
 from PySide6 import QtGui, QtWidgets
 
-from ui.main_window import DEFAULT_EXAMPLE, EXAMPLES_DIR, MainWindow, Prompter
+from ui.dialogs import Prompter
+from ui.main_window import DEFAULT_EXAMPLE, EXAMPLES_DIR, MainWindow
 
 
 def create_main_window(project_path: str | Path | None = None, autosave_dir: str | Path | None = None, *,

@@ -1,5 +1,6 @@
 """Qt widgets of the Mesoforge window: node editor, inspector, viewport, log."""
 
-from .main_window import MainWindow, Prompter
+from .dialogs import Prompter
+from .main_window import MainWindow
 
 __all__ = ["MainWindow", "Prompter"]

@@ -163,7 +163,7 @@ def index_ranges(lo_xyz, hi_xyz, n):
 
 # --------------------------------------------------------------- numba kernel
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, nogil=True)
 def _element_sdf(px, py, pz, ax, ay, az, g, kind):
     wx, wy, wz = px - ax, py - ay, pz - az
     s = wx * g[_DX] + wy * g[_DY] + wz * g[_DZ]
@@ -193,7 +193,7 @@ def _element_sdf(px, py, pz, ax, ay, az, g, kind):
     return d
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, nogil=True)
 def _param_window(a, dlt, x, reach, t0, t1):
     """Narrow [t0, t1] to the t where |a + t * dlt - x| <= reach."""
     if abs(dlt) < 1e-15:
@@ -207,7 +207,7 @@ def _param_window(a, dlt, x, reach, t0, t1):
     return max(t0, u), min(t1, v)
 
 
-@njit(cache=True, fastmath=False, parallel=True)
+@njit(cache=True, fastmath=False, parallel=True, nogil=True)
 def _sdf_planes(field, p0, p1, a, b, geo, kind, lo, hi, n, periodic, band):
     nel = a.shape[0]
     for pp in prange(p1 - p0):

@@ -90,7 +90,7 @@ def boundary_flags(faces, vertex_count):
 
 # --------------------------------------------------------------- numba kernel
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, nogil=True)
 def _seg_closest(px, py, pz, ax, ay, az, bx, by, bz):
     ex, ey, ez = bx - ax, by - ay, bz - az
     ee = ex * ex + ey * ey + ez * ez
@@ -100,7 +100,7 @@ def _seg_closest(px, py, pz, ax, ay, az, bx, by, bz):
     return min(1.0, max(0.0, t))
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, nogil=True)
 def _closest_bary(px, py, pz, tri):
     """Barycentric coordinates of the point of triangle ``tri`` closest to p.
 
@@ -160,7 +160,7 @@ def _closest_bary(px, py, pz, tri):
     return 1.0 - v - w, v, w
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, nogil=True)
 def _on_boundary(u, v, w, k_edge, k_vert):
     """k_edge/k_vert: boundary flags of the edges opposite / the corners."""
     zu, zv, zw = u == 0.0, v == 0.0, w == 0.0
@@ -172,7 +172,7 @@ def _on_boundary(u, v, w, k_edge, k_vert):
     return k_vert[0] if u != 0.0 else (k_vert[1] if v != 0.0 else k_vert[2])
 
 
-@njit(cache=True, fastmath=False, parallel=True)
+@njit(cache=True, fastmath=False, parallel=True, nogil=True)
 def _surface_planes(field, p0, p1, tris, rads, normals, ebound, vbound, tlo, thi,
                     walls, wlo, whi, n, periodic, band, normal_mode):
     ntri, nwall = tris.shape[0], walls.shape[0]

@@ -14,13 +14,13 @@ from engine.graph.schema import Param, Port
 from engine.graph.values import Solid, VoxelModel
 
 
-def _solid_from_sdf(sdf: np.ndarray, cell_size: float) -> Solid:
+def _solid_from_sdf(sdf: np.ndarray, cell_size: float, progress=None) -> Solid:
     if not np.any(sdf < 0):
         raise NodeInputError("the result is empty: no grid point lies inside the solid "
                              "(thicken the skeleton or raise the resolution)")
     if np.all(sdf < 0):
         raise NodeInputError("the result fills the whole cell: nothing to mesh")
-    verts, faces = periodic_mesh(sdf, cell_size=cell_size)
+    verts, faces = periodic_mesh(sdf, cell_size=cell_size, progress=progress)
     return Solid(sdf, verts, faces, cell_size)
 
 
@@ -57,7 +57,7 @@ class ObjectNode(NodeType):
                                            periodic=True, progress=ctx.progress))
         ctx.check()
         sdf = csg_reduce(fields, "union")
-        return {"solid": _solid_from_sdf(sdf, params["cell_size"])}
+        return {"solid": _solid_from_sdf(sdf, params["cell_size"], ctx.progress)}
 
 
 @register
@@ -83,7 +83,7 @@ class CSGBooleanNode(NodeType):
         if len(set(sizes)) != 1:
             raise NodeInputError(f"inputs must have the same cell size, got {sizes}", where="solids")
         sdf = csg_reduce([s.sdf for s in solids], params["operation"])
-        return {"solid": _solid_from_sdf(sdf, sizes[0])}
+        return {"solid": _solid_from_sdf(sdf, sizes[0], ctx.progress)}
 
 
 @register

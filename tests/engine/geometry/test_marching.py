@@ -154,3 +154,30 @@ def test_drop_specks_keeps_big_pieces():
     f = np.vstack([tet, tet + 4])
     v2, f2 = drop_specks(v, f, 1e-6)
     assert len(v2) == 4 and np.array_equal(f2, tet)
+
+
+def test_slab_meshing_equals_one_marching_cubes_call_and_cancels():
+    # The slab-wise extraction must give the same surface as one skimage call
+    # on the whole padded grid (compared as sets of triangles by coordinates).
+    from skimage.measure import marching_cubes
+    from engine.geometry import marching
+    from engine.geometry.cancel import Cancelled
+
+    rng = np.random.default_rng(5)
+    field = np.asarray(rng.normal(size=(60, 20, 20)), np.float32)
+    v1, f1 = marching._slab_marching_cubes(field, 0.0, None)
+    v2, f2, _, _ = marching_cubes(field, level=0.0, gradient_direction="descent", allow_degenerate=True)
+    from scipy.spatial import cKDTree
+
+    def canonical(v, f):
+        tri = np.asarray(v, np.float64)[f]                       # (f, 3, 3)
+        order = np.lexsort(tri.transpose(2, 0, 1)[::-1], axis=1)   # corners in a fixed order
+        return np.take_along_axis(tri, order[:, :, None], axis=1).reshape(-1, 9)
+
+    assert len(f1) == len(f2) and len(v1) == len(np.unique(v2, axis=0))
+    a, b = canonical(v1, f1), canonical(v2, f2)
+    assert cKDTree(b).query(a)[0].max() < 1e-4 and cKDTree(a).query(b)[0].max() < 1e-4
+    calls = []
+    with pytest.raises(Cancelled):
+        marching.periodic_mesh(field, progress=lambda d, t: calls.append(d) or d < 1)
+    assert calls[-1] == 1
