@@ -4,6 +4,7 @@
     mesoforge PROJECT.json         open a project in the window
     mesoforge eval GRAPH.json [--out cell.stl] [--tile 3 3 3] [--node ID] [--resolution N] [--json]
     mesoforge render GRAPH.json --png out.png [--tile 3 3 3]
+    mesoforge homogenize INPUT [--E 1 --nu 0.45] [--res N] [--json]
 """
 
 from __future__ import annotations
@@ -161,6 +162,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--png", required=True)
     r.add_argument("--out", help="also write the mesh")
     r.add_argument("--tile", nargs=3, type=int, default=(1, 1, 1), metavar=("NX", "NY", "NZ"))
+    from app import homogenize_cmd
+    homogenize_cmd.add_parser(sub)
     return p
 
 
@@ -175,6 +178,9 @@ def main(argv: list[str] | None = None) -> int:
         return cmd_eval(args)
     if args.command == "render":
         return cmd_render(args)
+    if args.command == "homogenize":
+        from app import homogenize_cmd
+        return homogenize_cmd.run(args)
     build_parser().print_help()
     return 2
 

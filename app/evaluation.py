@@ -78,6 +78,9 @@ def report_json(doc: GraphDocument, report: EvalReport) -> dict:
             continue
         entry = {"id": nid, "type": doc.nodes[nid].type_name, "status": r.status,
                  "seconds": round(r.seconds, 6)}
+        for port, value in (report.outputs.get(nid) or {}).items():
+            if hasattr(value, "summary"):  # e.g. a Stiffness: C and its constants
+                entry.setdefault("outputs", {})[port] = value.summary()
         if r.error:
             entry["error"] = r.error
             if r.where:

@@ -164,3 +164,46 @@ class VoxelModel:
     @property
     def volume_fraction(self) -> float:
         return float(self.occupancy.mean())
+
+
+@dataclass(frozen=True)
+class Stiffness:
+    """Homogenized elastic stiffness of a periodic cell (paper 6.6).
+
+    C : (6, 6) Voigt stiffness, engineering shear strains, order
+        (xx, yy, zz, yz, xz, xy); (3, 3) (xx, yy, xy) for 2D plane stress.
+    E, nu, rho : base material; density : solid volume fraction of the cell;
+    constants : engineering constants (E_x ... nu_avg, eqs. 1-8 of Liu et al.);
+    symmetry : detected symmetry class; zener : Zener ratio (cubic only, else None);
+    dropped_fraction : material removed as disconnected islands (fraction of the cell).
+    """
+
+    C: np.ndarray
+    E: float
+    nu: float
+    rho: float
+    density: float
+    constants: dict
+    symmetry: str
+    zener: float | None
+    dropped_fraction: float
+    iterations: int
+    resolution: int
+
+    def __post_init__(self):
+        object.__setattr__(self, "C", _frozen(self.C))
+
+    @property
+    def S(self) -> np.ndarray:
+        return np.linalg.inv(self.C)
+
+    @property
+    def effective_density(self) -> float:
+        """Mass per cell volume (kg/m^3): base density times solid fraction."""
+        return self.rho * self.density
+
+    def summary(self) -> dict:
+        return {"C": self.C.tolist(), "density": self.density, "effective_density": self.effective_density,
+                "symmetry": self.symmetry, "zener": self.zener, "dropped_fraction": self.dropped_fraction,
+                "iterations": self.iterations, "resolution": self.resolution, "E": self.E, "nu": self.nu,
+                "rho": self.rho, **self.constants}
