@@ -5,6 +5,8 @@
     mesoforge eval GRAPH.json [--out cell.stl] [--tile 3 3 3] [--node ID] [--resolution N] [--json]
     mesoforge render GRAPH.json --png out.png [--tile 3 3 3]
     mesoforge homogenize INPUT [--E 1 --nu 0.45] [--res N] [--json]
+    mesoforge grow TILESET --size 20x20 --out tiling.json [--png t.png] [--hints T=1,+=2] [--json]
+    mesoforge study TILESET [--hints ...] [--n 100] [--out study.csv] [--scheduler ADDR] [--json]
 """
 
 from __future__ import annotations
@@ -164,6 +166,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--tile", nargs=3, type=int, default=(1, 1, 1), metavar=("NX", "NY", "NZ"))
     from app import homogenize_cmd
     homogenize_cmd.add_parser(sub)
+    from app import growth_cmd
+    growth_cmd.add_parsers(sub)
     return p
 
 
@@ -181,6 +185,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "homogenize":
         from app import homogenize_cmd
         return homogenize_cmd.run(args)
+    if args.command in ("grow", "study"):
+        from app import growth_cmd
+        return growth_cmd.run(args)
     build_parser().print_help()
     return 2
 

@@ -4,7 +4,9 @@ Every edit becomes a `SetParam` pushed on the undo stack (successive edits of
 one parameter within a second merge into one undo item, as when holding a
 spin box arrow).  A value the engine refuses is shown inline and the editor
 goes back to the document's value; the document is unchanged.  Widgets are
-refreshed from document events, so undo/redo shows up here too.
+refreshed from document events, so undo/redo shows up here too.  When the
+node's latest evaluation produced a `Stiffness`, a `StiffnessPanel` shows it
+under the parameters.
 """
 
 from __future__ import annotations
@@ -16,6 +18,9 @@ from typing import Any, Callable
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from engine.graph import FAMILY_COLOURS, GraphDocument, GraphError, Param, SetLabel, SetParam, UndoStack, all_node_types
+from engine.graph.values import Stiffness
+
+from .stiffness_panel import StiffnessPanel
 
 MERGE_SECONDS = 1.0
 _BIG = 1e15
@@ -311,6 +316,7 @@ class Inspector(QtWidgets.QWidget):
         self.node_id: str | None = None
         self.editors: dict[str, ParamEditor] = {}
         self._results: dict = {}
+        self._outputs: dict = {}
         self._last_edit: tuple[tuple[str, str], float] | None = None
 
         outer = QtWidgets.QVBoxLayout(self)
@@ -342,6 +348,10 @@ class Inspector(QtWidgets.QWidget):
         self.form = QtWidgets.QFormLayout(self.params_box)
         self.form.setFieldGrowthPolicy(QtWidgets.QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         outer.addWidget(self.params_box)
+
+        self.stiffness_panel = StiffnessPanel()
+        self.stiffness_panel.hide()
+        outer.addWidget(self.stiffness_panel)
 
         self.error_label = QtWidgets.QLabel("")
         self.error_label.setWordWrap(True)
@@ -376,6 +386,7 @@ class Inspector(QtWidgets.QWidget):
         has = node_id is not None
         for w in (self.ident_box, self.params_box, self.status_box):
             w.setVisible(has)
+        self._show_stiffness()
         if not has:
             self.title.setText("No node selected")
             self.description.setText("Select a node in the editor to edit its parameters.")
@@ -464,9 +475,27 @@ class Inspector(QtWidgets.QWidget):
             self.set_node(None)
 
     # -- status -----------------------------------------------------------------
-    def set_results(self, results: dict) -> None:
+    def set_results(self, results: dict, outputs: dict | None = None) -> None:
+        """Statuses (and, when given, output values) of the latest evaluation."""
         self._results = dict(results)
+        self._outputs = dict(outputs or {})
         self._show_status()
+        self._show_stiffness()
+
+    def shown_stiffness(self) -> Stiffness | None:
+        """The Stiffness the selected node produced in the latest evaluation, if any."""
+        if self.node_id is None:
+            return None
+        for value in self._outputs.get(self.node_id, {}).values():
+            if isinstance(value, Stiffness):
+                return value
+        return None
+
+    def _show_stiffness(self) -> None:
+        stiffness = self.shown_stiffness()
+        if stiffness is not self.stiffness_panel.stiffness:
+            self.stiffness_panel.set_stiffness(stiffness)
+        self.stiffness_panel.setVisible(stiffness is not None)
 
     def _show_status(self) -> None:
         if self.node_id is None:

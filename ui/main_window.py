@@ -25,7 +25,7 @@ from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
 from .inspector import Inspector
 from .node_editor import NodeEditor
-from .viewport import Viewport, pick_display_nodes, skeleton_of, solid_of
+from .viewport import Viewport, pick_display_nodes, pick_stiffness_node, skeleton_of, solid_of, stiffness_of
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "resources" / "examples"
 DEFAULT_EXAMPLE = "octet.json"
@@ -52,6 +52,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.eval_count = 0  # finished (not superseded) evaluations, for waiting in tests
         self.shown_solid_id: str | None = None
         self.shown_skeleton_id: str | None = None
+        self.shown_stiffness_id: str | None = None  # the Stiffness the viewport draws a material sphere of
         self.log_lines: list[tuple[str, str]] = []
         self._eval_total = 0
         self._eval_done: list[NodeResult] = []
@@ -163,6 +164,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.act_skeleton = self._action("Show &Skeleton", self.viewport.set_show_skeleton, checkable=True,
                                          checked=True)
         self.act_solid = self._action("Show S&olid", self.viewport.set_show_solid, checkable=True, checked=True)
+        self.act_sphere = self._action("Show &Material Sphere", self.viewport.set_show_sphere, checkable=True,
+                                       checked=True)
         self.act_fit = self._action("Fit Node Graph", self.editor.fit_view, "F")
         self.act_arrange = self._action("Arrange Nodes", self.editor.arrange_nodes, "Ctrl+L")
         self.act_reset_camera = self._action("Reset Camera", self.viewport.reset_camera, "R")
@@ -205,6 +208,7 @@ class MainWindow(QtWidgets.QMainWindow):
         view_menu.addAction(self.act_tiling)
         view_menu.addAction(self.act_skeleton)
         view_menu.addAction(self.act_solid)
+        view_menu.addAction(self.act_sphere)
         view_menu.addSeparator()
         view_menu.addAction(self.act_fit)
         view_menu.addAction(self.act_arrange)
@@ -280,6 +284,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_doc_event(self, event: str, payload) -> None:
         if event in ("node_moved", "label_changed"):
             return  # layout only: results cannot change
+        if event == "node_removed" and payload == self.shown_stiffness_id:
+            self.update_viewport()  # its material sphere goes now, not after the next evaluation
         if self.act_auto.isChecked():
             self._debounce.start()
 
@@ -345,7 +351,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._log_report(report)
         if not report.cancelled:
             self.editor.set_results(report.results)
-            self.inspector.set_results(report.results)
+            self.inspector.set_results(report.results, report.outputs)
             self.update_viewport()
         self.evaluation_finished.emit(report)
 
@@ -378,9 +384,17 @@ class MainWindow(QtWidgets.QMainWindow):
                            f"volume fraction {solid.volume_fraction:.3f})")
         if skel_id:
             caption.append(f"skeleton: {skel_id}")
+        stiffness_id = pick_stiffness_node(self.doc, outputs, sel)
+        stiffness = stiffness_of(outputs[stiffness_id]) if stiffness_id else None
+        sphere_caption = ""
+        if stiffness is not None:
+            sphere_caption = (f"material sphere: {stiffness_id} ({stiffness.symmetry}, "
+                              f"E_avg {stiffness.constants.get('E_avg', float('nan')):.4g})")
         self.shown_solid_id, self.shown_skeleton_id = solid_id, skel_id
+        self.shown_stiffness_id = stiffness_id
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
-                                  skeleton_emphasis=bool(sel and sel == skel_id))
+                                  skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
+                                  sphere_caption=sphere_caption)
 
     def current_solid(self) -> Solid | None:
         return self.viewport.solid
@@ -396,7 +410,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.display_name = name
         self._dirty_without_undo = False
         self.editor.set_results({})
-        self.inspector.set_results({})
+        self.inspector.set_results({}, {})
         self.update_viewport()
         self._update_title()
         QtCore.QTimer.singleShot(0, self.editor.fit_view)

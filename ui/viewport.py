@@ -2,7 +2,9 @@
 
 A thin adapter over a pyvistaqt `QtInteractor`; everything here runs on the
 GUI thread.  `pick_display_nodes` decides, from an evaluation's outputs,
-which node's solid and which skeleton to show; it is plain Python.
+which node's solid and which skeleton to show, and `pick_stiffness_node`
+which Material Matrix result gets its material sphere (paper Fig. 11c)
+drawn beside the cell block; both are plain Python.
 """
 
 from __future__ import annotations
@@ -15,13 +17,19 @@ from pyvistaqt import QtInteractor
 from PySide6 import QtWidgets
 
 from engine.graph import GraphDocument
-from engine.graph.values import Skeleton, Solid, VoxelModel
+from engine.graph.values import Skeleton, Solid, Stiffness, VoxelModel
+from engine.physics.material_sphere import material_sphere_polydata
 
 SOLID_COLOUR = "#d8cfc0"
 LINE_COLOUR = "#4696dc"
 POINT_COLOUR = "#e8b03c"
 SURFACE_COLOUR = "#6aa8e0"
 BOX_COLOUR = "#8a9099"
+SPHERE_SUBDIVISIONS = 4      # icosphere: 10 * 4**4 + 2 = 2562 directions
+SPHERE_RADIUS = 0.5          # largest radius, as a fraction of the cell block's edge
+SPHERE_GAP = 0.3             # free space between block and sphere, same unit
+SPHERE_CMAP = "viridis"
+SPHERE_BAR_TITLE = "E(d)"
 
 
 # -- what to show ------------------------------------------------------------------
@@ -97,6 +105,30 @@ def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None =
     return solid_id, skel_id
 
 
+def stiffness_of(outputs: dict) -> Stiffness | None:
+    """The 3D (6x6) Stiffness among a node's outputs."""
+    for value in outputs.values():
+        if isinstance(value, Stiffness) and np.shape(value.C) == (6, 6):
+            return value
+    return None
+
+
+def pick_stiffness_node(doc: GraphDocument, outputs: dict, selected: str | None = None) -> str | None:
+    """Node whose material sphere to draw: the selected node if it produced a
+    3D Stiffness, else the last such node in topological order (None if none did)."""
+    outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
+    if selected in outputs and stiffness_of(outputs[selected]) is not None:
+        return selected
+    try:
+        order = doc.topological_order()
+    except Exception:
+        order = list(doc.nodes)
+    for nid in reversed(order):
+        if nid in outputs and stiffness_of(outputs[nid]) is not None:
+            return nid
+    return None
+
+
 # -- geometry helpers ------------------------------------------------------------------
 def tile_offsets(tiles: int, cell_size: float) -> np.ndarray:
     """(tiles**3, 3) translations placing the original cell in the middle."""
@@ -111,6 +143,23 @@ def tiled_arrays(vertices: np.ndarray, faces: np.ndarray, offsets: np.ndarray) -
     v = (vertices[None, :, :] + offsets[:, None, :]).reshape(-1, 3)
     f = (faces[None, :, :] + (np.arange(len(offsets)) * n)[:, None, None]).reshape(-1, 3)
     return v, f
+
+
+def block_bounds(tiles: int, cell_size: float) -> tuple[float, float]:
+    """(lo, hi) along every axis of the block of `tiles`**3 cells drawn by the viewport."""
+    lo = -cell_size * ((tiles - 1) // 2)
+    return lo, lo + tiles * cell_size
+
+
+def sphere_placement(tiles: int, cell_size: float, max_radius: float) -> tuple[float, np.ndarray]:
+    """(scale, centre) putting a surface of largest radius `max_radius` to the
+    right (+x) of the cell block, its largest radius `SPHERE_RADIUS` of the block edge."""
+    lo, hi = block_bounds(tiles, cell_size)
+    edge = hi - lo
+    radius = SPHERE_RADIUS * edge
+    scale = radius / max_radius if max_radius > 0 else 1.0
+    mid = 0.5 * (lo + hi)
+    return scale, np.array([hi + SPHERE_GAP * edge + radius, mid, mid])
 
 
 def polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
@@ -135,6 +184,12 @@ class Viewport(QtWidgets.QWidget):
         self.show_solid = True
         self.solid: Solid | None = None
         self.skeleton: Skeleton | None = None
+        self.stiffness: Stiffness | None = None
+        self.sphere_caption = ""
+        self.show_sphere = True
+        self._sphere_cache: tuple[bytes, pv.PolyData] | None = None
+        self._sphere_points = 0
+        self._sphere_note = ""
         self.caption = ""
         self.skeleton_emphasis = False
         self._shown_points = 0
@@ -144,10 +199,13 @@ class Viewport(QtWidgets.QWidget):
 
     # -- state --------------------------------------------------------------------
     def show_result(self, solid: Solid | None, skeleton: Skeleton | None, caption: str = "",
-                    *, skeleton_emphasis: bool = False) -> None:
-        """Display `solid` and `skeleton` (either may be None); re-renders."""
+                    *, skeleton_emphasis: bool = False, stiffness: Stiffness | None = None,
+                    sphere_caption: str = "") -> None:
+        """Display `solid`, `skeleton` and the material sphere of `stiffness` (any may be None);
+        `sphere_caption` joins the caption while the sphere is drawn.  Re-renders."""
         self.solid, self.skeleton, self.caption = solid, skeleton, caption
         self.skeleton_emphasis = skeleton_emphasis
+        self.stiffness, self.sphere_caption = stiffness, sphere_caption
         self.redraw()
 
     def set_tiling(self, tiles: int) -> None:
@@ -164,6 +222,14 @@ class Viewport(QtWidgets.QWidget):
         self.show_solid = bool(on)
         self.redraw()
 
+    def set_show_sphere(self, on: bool) -> None:
+        self.show_sphere = bool(on)
+        self.redraw()
+
+    def sphere_point_count(self) -> int:
+        """Number of material-sphere points currently shown (0 when none is)."""
+        return self._sphere_points
+
     def mesh_point_count(self) -> int:
         """Number of solid-mesh points currently shown (all tiles)."""
         return self._shown_points
@@ -175,9 +241,23 @@ class Viewport(QtWidgets.QWidget):
     def redraw(self) -> None:
         if self._closed:
             return
+        # Every add_mesh would render the window once (~0.1 s each in software
+        # GL); build the whole scene first and render it once.
+        self.plotter.suppress_rendering = True
+        try:
+            self._build_scene()
+        finally:
+            self.plotter.suppress_rendering = False
+        self.plotter.render()
+
+    def _build_scene(self) -> None:
         p = self.plotter
+        if SPHERE_BAR_TITLE in p.scalar_bars:
+            p.remove_scalar_bar(SPHERE_BAR_TITLE)  # clear_actors can leave a bar whose mapper was replaced
         p.clear_actors()
         self._shown_points = 0
+        self._sphere_points = 0
+        self._sphere_note = ""
         c = self.cell_size()
         offsets = tile_offsets(self.tiles, c)
         if self.show_solid and self.solid is not None and len(self.solid.faces):
@@ -190,16 +270,19 @@ class Viewport(QtWidgets.QWidget):
         if self.show_skeleton and self.skeleton is not None:
             self._draw_skeleton(self.skeleton, c)
         self._draw_cell_boxes(c)
-        if self.caption:
-            p.add_text(self.caption, position="upper_left", font_size=9, color="white", name="caption")
+        if self.show_sphere and self.stiffness is not None:
+            self._draw_material_sphere(self.stiffness, c)
+        sphere_line = self.sphere_caption if self._sphere_points else self._sphere_note
+        caption = "\n".join(t for t in (self.caption, sphere_line) if t)
+        if caption:
+            p.add_text(caption, position="upper_left", font_size=9, color="white", name="caption")
         if self.solid is None and self.skeleton is None:
             p.add_text("nothing to show yet: evaluate a graph with a solid or skeleton node",
                        position="lower_left", font_size=9, color="#9aa0a6", name="hint")
-        key = (self.tiles, round(c, 9))
+        key = (self.tiles, round(c, 9), self._sphere_points > 0)
         if key != self._camera_key:
             self._camera_key = key
             self._home_camera()
-        p.render()
 
     def _home_camera(self) -> None:
         # Slightly off the cube diagonal: the exact isometric view hides
@@ -232,6 +315,30 @@ class Viewport(QtWidgets.QWidget):
             lo, hi = -c * ((self.tiles - 1) // 2), c * (1 + (self.tiles - 1) // 2)
             self.plotter.add_mesh(pv.Box(bounds=(lo, hi, lo, hi, lo, hi)), style="wireframe",
                                   color="#5a6068", line_width=1.0, name="tiling_box")
+
+    def _sphere_mesh(self, stiffness: Stiffness) -> pv.PolyData:
+        """The unscaled material sphere, recomputed only when C changes."""
+        key = np.ascontiguousarray(stiffness.C).tobytes()
+        if self._sphere_cache is None or self._sphere_cache[0] != key:
+            self._sphere_cache = (key, material_sphere_polydata(stiffness.C, subdivisions=SPHERE_SUBDIVISIONS))
+        return self._sphere_cache[1]
+
+    def _draw_material_sphere(self, stiffness: Stiffness, c: float) -> None:
+        try:
+            base = self._sphere_mesh(stiffness)
+        except ValueError:
+            self._sphere_note = "material sphere: none, C is singular (the cell is a mechanism)"
+            return
+        radii = np.linalg.norm(base.points, axis=1)
+        scale, centre = sphere_placement(self.tiles, c, float(radii.max()))
+        mesh = base.copy()
+        mesh.points = base.points * scale + centre
+        self.plotter.add_mesh(
+            mesh, scalars="E", cmap=SPHERE_CMAP, smooth_shading=True, specular=0.2, name="material_sphere",
+            scalar_bar_args={"title": SPHERE_BAR_TITLE, "vertical": False, "position_x": 0.55, "position_y": 0.04,
+                             "width": 0.4, "height": 0.07, "n_labels": 4, "color": "white", "fmt": "%.3g",
+                             "title_font_size": 14, "label_font_size": 11})
+        self._sphere_points = int(mesh.n_points)
 
     def reset_camera(self) -> None:
         self._home_camera()

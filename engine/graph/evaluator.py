@@ -42,6 +42,11 @@ class EvalReport:
     outputs: dict[str, dict[str, Any]] = field(default_factory=dict)
     seconds: float = 0.0
     cancelled: bool = False
+    # set by front ends: which request this answers, whether a newer one replaced it,
+    # and an unexpected exception outside any node (a bug, reported rather than raised)
+    tag: Any = None
+    superseded: bool = False
+    internal_error: str = ""
 
     @property
     def ok(self) -> bool:

@@ -207,3 +207,62 @@ class Stiffness:
                 "symmetry": self.symmetry, "zener": self.zener, "dropped_fraction": self.dropped_fraction,
                 "iterations": self.iterations, "resolution": self.resolution, "E": self.E, "nu": self.nu,
                 "rho": self.rho, **self.constants}
+
+
+@dataclass(frozen=True)
+class TilingValue:
+    """A grown tiling with the tile set it came from (port type "Tiling").
+
+    tiling : engine.growth.Tiling (tile indices read-only); tileset :
+    engine.growth.TileSet. Both are immutable; downstream nodes render or
+    homogenize the tiling without knowing where the set was loaded from.
+    """
+
+    tiling: object
+    tileset: object
+
+    @property
+    def ndim(self) -> int:
+        return int(self.tiling.tiles.ndim)
+
+
+@dataclass(frozen=True)
+class Field:
+    """Samples on a regular grid over an axis-aligned box (port type "Field").
+
+    values : grid_shape + component_shape float64, read-only; the grid is
+        indexed like an image / voxel grid, ``[y, x]`` or ``[z, y, x]``, one
+        sample per cell at the cell centre.
+    lo, hi : (ndim,) float64, box corners in ``(x, y[, z])`` order.
+    kind : "scalar", "vector" or "tensor" (trailing component axes 0, 1, 2).
+    """
+
+    values: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    kind: str = "scalar"
+
+    def __post_init__(self):
+        object.__setattr__(self, "values", _frozen(self.values))
+        object.__setattr__(self, "lo", _frozen(self.lo).reshape(-1))
+        object.__setattr__(self, "hi", _frozen(self.hi).reshape(-1))
+        extra = {"scalar": 0, "vector": 1, "tensor": 2}.get(self.kind)
+        if extra is None:
+            raise ValueError(f"Field: kind must be 'scalar', 'vector' or 'tensor'; got {self.kind!r}")
+        if self.lo.shape != self.hi.shape or self.values.ndim != self.lo.size + extra \
+                or np.any(self.hi <= self.lo):
+            raise ValueError(f"Field: values {self.values.shape} ({self.kind}) do not fit a box "
+                             f"lo={self.lo.tolist()}, hi={self.hi.tolist()} with hi > lo")
+
+    @property
+    def ndim(self) -> int:
+        return int(self.lo.size)
+
+    @property
+    def grid_shape(self) -> tuple:
+        return tuple(self.values.shape[:self.ndim])
+
+    @property
+    def spacing(self) -> np.ndarray:
+        """(ndim,) cell size in ``(x, y[, z])`` order."""
+        return (self.hi - self.lo) / np.array(self.grid_shape[::-1], dtype=np.float64)

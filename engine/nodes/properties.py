@@ -1,0 +1,59 @@
+"""Material Matrix node (paper 6.6): periodic homogenization of the voxelized cell."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.geometry.resample import resample_periodic
+from engine.graph.node import NodeType, register
+from engine.graph.schema import Param, Port
+from engine.graph.values import Stiffness
+from engine.physics.elastic import engineering_constants, symmetry_class, zener_ratio
+from engine.physics.homogenize3d import homogenize_voxels
+
+
+def stiffness_from_result(result, *, E, nu, rho, resolution) -> Stiffness:
+    """Wrap a solver result with its engineering constants.
+
+    A cell that does not connect along every axis (a mechanism, e.g. one
+    beam) has a singular C: it is kept, its constants are left out and its
+    symmetry is reported as "singular" instead of failing the node.
+    """
+    C = np.asarray(result.C)
+    eig = np.linalg.eigvalsh(0.5 * (C + C.T))
+    if eig[0] <= 1e-9 * max(eig[-1], 1e-300):
+        constants, sym, zener = {}, "singular", None
+    else:
+        constants = engineering_constants(C)
+        sym = symmetry_class(C, tol=1e-3)
+        zener = float(zener_ratio(C)) if sym == "cubic" else None
+    return Stiffness(C, E, nu, rho, float(result.density), constants, sym, zener,
+                     float(result.dropped_fraction), int(result.iterations), int(resolution))
+
+
+@register
+class MaterialMatrixNode(NodeType):
+    """Effective stiffness tensor C of the periodic cell by voxel homogenization
+    (trilinear hexes, periodic boundary conditions), with engineering constants."""
+
+    type_name = "MaterialMatrix"
+    title = "Material Matrix"
+    code = "mat"
+    family = "property"
+    inputs = (Port("voxels", "Voxel"),)
+    outputs = (Port("stiffness", "Stiffness"),)
+    params = (
+        Param("resolution", "int", 64, 0, 256, unit="voxels",
+              doc="voxels per cell edge for the solve (0 = the Object grid as is); the paper used 100"),
+    )
+
+    def evaluate(self, inputs, params, ctx):
+        vox = inputs["voxels"]
+        n = params["resolution"]
+        if n and n != vox.occupancy.shape[0]:
+            occupancy = resample_periodic(vox.solid.sdf, n) < 0
+        else:
+            occupancy = np.asarray(vox.occupancy)
+        result = homogenize_voxels(occupancy.astype(np.float64), E=vox.E, nu=vox.nu, progress=ctx.progress)
+        return {"stiffness": stiffness_from_result(result, E=vox.E, nu=vox.nu, rho=vox.rho,
+                                                   resolution=occupancy.shape[0])}
