@@ -39,7 +39,7 @@ __all__ = ["HomogenizationResult", "homogenize_grid", "estimate_memory"]
 PROGRESS_TOTAL = 1000
 # The coarsest multigrid level is solved densely once it has at most this
 # many dofs (so grids this small are solved directly, in one iteration).
-MAX_COARSE_DOFS = {2: 2000, 3: 3000}
+MAX_COARSE_DOFS = {2: 20000, 3: 3000}  # 2D: large sparse coarsest level keeps thin members
 # threads=None: cells whose fine operator costs fewer multiply-adds per
 # application than this run on one thread (3D ~100k voxels; every practical
 # 2D cell): there the dozen thread barriers per iteration cost more than they
