@@ -44,16 +44,24 @@ def run(args) -> int:
     except ValueError as exc:
         return fail(str(exc))
     C = np.asarray(result.C)
-    sym = symmetry_class(C, tol=1e-3)
+    try:
+        sym = symmetry_class(C, tol=1e-3)
+        constants = engineering_constants(C)
+    except ValueError:  # a mechanism: C is singular, no compliance
+        sym, constants = "singular", {}
     out = {
         "input": args.input, "kind": kind, "shape": list(grid.shape), "E": args.E, "nu": args.nu,
         "density": float(result.density), "dropped_fraction": float(result.dropped_fraction),
-        "C": C.tolist(), "S": np.linalg.inv(C).tolist(), "constants": engineering_constants(C),
+        "C": C.tolist(), "S": np.linalg.inv(C).tolist() if constants else None, "constants": constants,
         "symmetry": sym, "zener": float(zener_ratio(C)) if sym == "cubic" else None,
         "iterations": int(result.iterations), "seconds": round(time.perf_counter() - t0, 4),
         "convention": "Voigt, engineering shear strains, order (xx, yy, zz, yz, xz, xy); 2D (xx, yy, xy)",
         **({"source": info} if info else {}),
     }
+    if kind == "pixels" and sym != "singular":
+        from engine.physics.material_sphere import material_polar
+        theta, e_theta = material_polar(C, n=72)
+        out["polar"] = {"theta_deg": np.degrees(theta).round(6).tolist(), "E": e_theta.tolist()}
     if args.json:
         print(json.dumps(out, indent=1, default=float))
         return 0

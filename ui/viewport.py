@@ -18,7 +18,7 @@ from PySide6 import QtWidgets
 
 from engine.graph import GraphDocument
 from engine.graph.values import Skeleton, Solid, Stiffness, VoxelModel
-from engine.physics.material_sphere import material_sphere_polydata
+from engine.physics.material_sphere import material_polar, material_sphere_polydata
 
 SOLID_COLOUR = "#d8cfc0"
 LINE_COLOUR = "#4696dc"
@@ -106,11 +106,22 @@ def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None =
 
 
 def stiffness_of(outputs: dict) -> Stiffness | None:
-    """The 3D (6x6) Stiffness among a node's outputs."""
+    """The Stiffness among a node's outputs: 3D (6x6, drawn as the material
+    sphere) or 2D plane stress (3x3, drawn as its polar curve E(theta))."""
     for value in outputs.values():
-        if isinstance(value, Stiffness) and np.shape(value.C) == (6, 6):
+        if isinstance(value, Stiffness) and np.shape(value.C) in ((6, 6), (3, 3)):
             return value
     return None
+
+
+def material_polar_polydata(C2d: np.ndarray, n: int = 360) -> pv.PolyData:
+    """The 2D counterpart of the material sphere: the closed curve E(theta) (1, cos, sin)
+    in the z = 0 plane, with point array "E"."""
+    theta, E = material_polar(C2d, n=n)
+    pts = np.column_stack([E * np.cos(theta), E * np.sin(theta), np.zeros_like(theta)])
+    curve = pv.lines_from_points(np.vstack([pts, pts[:1]]))
+    curve["E"] = np.append(E, E[0])
+    return curve
 
 
 def pick_stiffness_node(doc: GraphDocument, outputs: dict, selected: str | None = None) -> str | None:
@@ -320,7 +331,11 @@ class Viewport(QtWidgets.QWidget):
         """The unscaled material sphere, recomputed only when C changes."""
         key = np.ascontiguousarray(stiffness.C).tobytes()
         if self._sphere_cache is None or self._sphere_cache[0] != key:
-            self._sphere_cache = (key, material_sphere_polydata(stiffness.C, subdivisions=SPHERE_SUBDIVISIONS))
+            if np.shape(stiffness.C) == (3, 3):
+                mesh = material_polar_polydata(stiffness.C)
+            else:
+                mesh = material_sphere_polydata(stiffness.C, subdivisions=SPHERE_SUBDIVISIONS)
+            self._sphere_cache = (key, mesh)
         return self._sphere_cache[1]
 
     def _draw_material_sphere(self, stiffness: Stiffness, c: float) -> None:
@@ -333,8 +348,9 @@ class Viewport(QtWidgets.QWidget):
         scale, centre = sphere_placement(self.tiles, c, float(radii.max()))
         mesh = base.copy()
         mesh.points = base.points * scale + centre
+        curve = {"line_width": 5, "render_lines_as_tubes": True} if mesh.n_lines else {}
         self.plotter.add_mesh(
-            mesh, scalars="E", cmap=SPHERE_CMAP, smooth_shading=True, specular=0.2, name="material_sphere",
+            mesh, scalars="E", cmap=SPHERE_CMAP, smooth_shading=True, specular=0.2, name="material_sphere", **curve,
             scalar_bar_args={"title": SPHERE_BAR_TITLE, "vertical": False, "position_x": 0.55, "position_y": 0.04,
                              "width": 0.4, "height": 0.07, "n_labels": 4, "color": "white", "fmt": "%.3g",
                              "title_font_size": 14, "label_font_size": 11})

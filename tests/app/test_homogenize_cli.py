@@ -72,3 +72,21 @@ def test_huge_grid_is_refused_up_front_with_an_estimate(tmp_path, capsys):
     np.save(p, np.ones((300, 300, 300), np.uint8))
     code, _, err = _run(capsys, p)
     assert code == 2 and "GB" in err and "300" in err
+
+
+def test_png_reports_the_polar_young_modulus(tmp_path, capsys):
+    from PIL import Image
+    img = np.full((20, 20), 255, np.uint8)
+    img[:, 8:12] = 0          # a vertical bar: stiff along y only...
+    img[8:12, :] = 0          # ...and a horizontal one: a square grid
+    p = tmp_path / "grid.png"
+    Image.fromarray(img).save(p)
+    code, out, err = _run(capsys, p, "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    E = np.array(res["polar"]["E"])
+    theta = np.radians(res["polar"]["theta_deg"])
+    # a square grid is stiffest along its bars (0 and 90 degrees), softest at 45
+    assert E[np.argmin(abs(theta - 0))] == pytest.approx(E[np.argmin(abs(theta - np.pi / 2))], rel=1e-6)
+    assert E[np.argmin(abs(theta - np.pi / 4))] < 0.5 * E[0]
+    assert E[0] == pytest.approx(res["constants"]["E_x"], rel=1e-9)

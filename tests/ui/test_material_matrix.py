@@ -253,3 +253,26 @@ def test_sphere_follows_reevaluation_and_failure(window, wait_eval):
     assert sphere_mesh(window).n_points == ICOSPHERE_POINTS
     assert panel.isVisibleTo(window.inspector)
     assert not panel.note.isVisibleTo(panel)
+
+
+def test_2d_tiling_stiffness_draws_its_polar_curve(window, qtbot, wait_eval):
+    # The 2D counterpart of the material sphere: E(theta) of a plane-stress C as a
+    # closed curve beside the cell, coloured by E; radii follow 1 / (n.S.n).
+    from engine.graph import AddNode, Connect
+    u = window.undo
+    u.push(AddNode("TileSet", node_id="ts"))
+    u.push(AddNode("Grow", {"size": [4, 4]}, node_id="grow"))
+    u.push(AddNode("TilingProperties", node_id="props"))
+    u.push(Connect("ts", "tileset", "grow", "tileset"))
+    u.push(Connect("grow", "tiling", "props", "tiling"))
+    report = wait_eval(window, 0, timeout=SOLVE_TIMEOUT_MS)
+    assert report.ok, report.errors
+    C = np.asarray(report.outputs["props"]["stiffness"].C)
+    assert C.shape == (3, 3)
+    curve = sphere_mesh(window)
+    assert curve is not None and curve.n_lines > 0 and curve.n_points == 361
+    S = np.linalg.inv(C)
+    t = np.linspace(0, 2 * np.pi, 360, endpoint=False)
+    n = np.stack([np.cos(t) ** 2, np.sin(t) ** 2, np.cos(t) * np.sin(t)], axis=1)
+    expect = 1.0 / np.einsum("ia,ab,ib->i", n, S, n)
+    np.testing.assert_allclose(np.asarray(curve["E"])[:360], expect, rtol=1e-9)
