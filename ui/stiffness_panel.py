@@ -21,6 +21,7 @@ from engine.graph.values import Stiffness
 from engine.physics.elastic import compliance
 
 VOIGT_LABELS = ("xx", "yy", "zz", "yz", "xz", "xy")
+PLANE_LABELS = ("xx", "yy", "xy")
 VOIGT_TIP = ("Voigt notation, order xx, yy, zz, yz, xz, xy.\n"
              "Shear strains are engineering strains (γ_yz = 2 ε_yz, …), so σ = C ε "
              "with no factors of 2 inside C; S = C⁻¹.")
@@ -157,9 +158,7 @@ class StiffnessPanel(QtWidgets.QGroupBox):
 
     # -- construction -------------------------------------------------------------------------
     def _build_table(self) -> QtWidgets.QTableWidget:
-        table = QtWidgets.QTableWidget(6, 6)
-        table.setHorizontalHeaderLabels(VOIGT_LABELS)
-        table.setVerticalHeaderLabels(VOIGT_LABELS)
+        table = QtWidgets.QTableWidget(0, 0)
         table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
         table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.ContiguousSelection)
         table.setToolTip(VOIGT_TIP)
@@ -174,13 +173,27 @@ class StiffnessPanel(QtWidgets.QGroupBox):
         for header in (hh, vh):
             header.setToolTip(VOIGT_TIP)
         table.setVerticalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        table.setFixedHeight(hh.sizeHint().height() + 6 * vh.defaultSectionSize() + 2 * table.frameWidth())
-        for r in range(6):
-            for c in range(6):
+        self._shape_table(table, VOIGT_LABELS)
+        return table
+
+    @staticmethod
+    def _shape_table(table: QtWidgets.QTableWidget, labels) -> None:
+        """Size the table for a 6x6 (3D) or 3x3 (2D plane stress) matrix."""
+        k = len(labels)
+        if table.rowCount() == k and table.horizontalHeaderItem(0) is not None \
+                and table.horizontalHeaderItem(0).text() == labels[0] and table.columnCount() == k:
+            return
+        table.setRowCount(k)
+        table.setColumnCount(k)
+        table.setHorizontalHeaderLabels(labels)
+        table.setVerticalHeaderLabels(labels)
+        hh, vh = table.horizontalHeader(), table.verticalHeader()
+        table.setFixedHeight(hh.sizeHint().height() + k * vh.defaultSectionSize() + 2 * table.frameWidth())
+        for r in range(k):
+            for c in range(k):
                 item = QtWidgets.QTableWidgetItem("")
                 item.setTextAlignment(QtCore.Qt.AlignmentFlag.AlignRight | QtCore.Qt.AlignmentFlag.AlignVCenter)
                 table.setItem(r, c, item)
-        return table
 
     @staticmethod
     def _value_label() -> QtWidgets.QLabel:
@@ -222,25 +235,28 @@ class StiffnessPanel(QtWidgets.QGroupBox):
     def _fill_matrix(self) -> None:
         m = self.matrix()
         name = "S" if self.show_compliance else "C"
-        self.exponent = common_exponent(m) if m is not None and m.shape == (6, 6) else 0
+        labels = PLANE_LABELS if m is not None and m.shape == (3, 3) else VOIGT_LABELS
+        self._shape_table(self.table, labels)
+        k = len(labels)
+        self.exponent = common_exponent(m) if m is not None and m.shape == (k, k) else 0
         unit = "1/Pa" if self.show_compliance else "Pa"
         scaled_unit = f"×10{_superscript(self.exponent)} {unit}" if self.exponent else unit
         what = "<b>S</b> = C⁻¹" if self.show_compliance else "<b>C</b>"
-        self.matrix_title.setText(f"{what} ({scaled_unit}), Voigt")
+        self.matrix_title.setText(f"{what} ({scaled_unit}), Voigt" + (", plane stress" if k == 3 else ""))
         self.compliance_toggle.setText("Show C" if self.show_compliance else "Show S")
-        if m is None or m.shape != (6, 6):
-            for r in range(6):
-                for c in range(6):
+        if m is None or m.shape != (k, k):
+            for r in range(k):
+                for c in range(k):
                     self.table.item(r, c).setText("")
                     self.table.item(r, c).setToolTip(VOIGT_TIP)
             return
         scale = 10.0 ** -self.exponent
-        for r in range(6):
-            for c in range(6):
+        for r in range(k):
+            for c in range(k):
                 x = float(m[r, c])
                 item = self.table.item(r, c)
                 item.setText(format_entry(x * scale))
-                item.setToolTip(f"{name}[{VOIGT_LABELS[r]}, {VOIGT_LABELS[c]}] = {x:.10g} {unit}\n\n{VOIGT_TIP}")
+                item.setToolTip(f"{name}[{labels[r]}, {labels[c]}] = {x:.10g} {unit}\n\n{VOIGT_TIP}")
 
     def _fill_values(self) -> None:
         s = self.stiffness

@@ -276,3 +276,9 @@ def test_2d_tiling_stiffness_draws_its_polar_curve(window, qtbot, wait_eval):
     n = np.stack([np.cos(t) ** 2, np.sin(t) ** 2, np.cos(t) * np.sin(t)], axis=1)
     expect = 1.0 / np.einsum("ia,ab,ib->i", n, S, n)
     np.testing.assert_allclose(np.asarray(curve["E"])[:360], expect, rtol=1e-9)
+    # the inspector shows the 3x3 plane-stress C as a table too
+    window.editor.select("props")
+    panel = window.inspector.stiffness_panel
+    assert panel.isVisibleTo(window.inspector)
+    assert panel.table.rowCount() == 3 and panel.table.horizontalHeaderItem(2).text() == "xy"
+    assert table_shows(panel, 0, 0, C[0, 0]) and table_shows(panel, 2, 2, C[2, 2])
