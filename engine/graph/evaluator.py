@@ -20,7 +20,7 @@ from typing import Any, Callable
 
 from .document import GraphDocument, GraphSnapshot, topological_order
 from .errors import GraphError
-from .node import Cancelled, CancelToken, EvalContext, node_type
+from .node import Cancelled, CancelToken, EvalContext, node_seed, node_type
 
 # Node statuses in a report.
 EVALUATED, CACHED, FAILED, BLOCKED, CANCELLED = "evaluated", "cached", "failed", "blocked", "cancelled"
@@ -91,10 +91,12 @@ class Evaluator:
         self._cache: OrderedDict[str, dict[str, Any]] = OrderedDict()
         self.max_entries = max_entries
         self._lock = threading.Lock()
+        self._state: dict[str, tuple[dict, int, dict]] = {}  # stateful node id -> (params, seed, outputs)
 
     def clear(self) -> None:
         with self._lock:
             self._cache.clear()
+            self._state.clear()
 
     def _cache_get(self, key: str):
         v = self._cache.get(key)
@@ -180,6 +182,8 @@ class Evaluator:
         key = hashlib.sha256(_canonical(key_src).encode()).hexdigest()
         cached = self._cache_get(key)
         if cached is not None:
+            if cls.stateful:
+                self._state[nid] = (params, node_seed(snap.seed, nid), cached)
             keys[nid] = key
             report.outputs[nid] = cached
             return NodeResult(nid, CACHED, key=key)
@@ -188,6 +192,8 @@ class Evaluator:
             vals = [report.outputs[e.src][e.src_port] for e in edges_by_port[port.name]]
             inputs[port.name] = vals if port.multi else (vals[0] if vals else None)
         ctx = EvalContext(nid, snap.seed, cancel=cancel, report=on_progress)
+        if cls.stateful and nid in self._state:
+            ctx.previous_params, ctx.previous_seed, ctx.previous = self._state[nid]
         t0 = time.perf_counter()
         try:
             ctx.check()
@@ -206,6 +212,8 @@ class Evaluator:
             return NodeResult(nid, FAILED, time.perf_counter() - t0,
                               error=f"node {nid!r} ({type_name}) produced no value for {missing}")
         self._cache_put(key, outputs)
+        if cls.stateful:
+            self._state[nid] = (params, ctx.seed, outputs)
         keys[nid] = key
         report.outputs[nid] = outputs
         return NodeResult(nid, EVALUATED, time.perf_counter() - t0, key=key)

@@ -63,6 +63,10 @@ class EvalContext:
         self._cancel = cancel
         self._report = report
         self._last = 0.0
+        # for stateful nodes: outputs, params and seed of this node's last evaluation
+        self.previous: dict | None = None
+        self.previous_params: dict | None = None
+        self.previous_seed: int | None = None
 
     def check(self) -> None:
         if self._cancel is not None and self._cancel.cancelled:
@@ -114,6 +118,9 @@ class NodeType:
     outputs: ClassVar[tuple[Port, ...]] = ()
     params: ClassVar[tuple[Param, ...]] = ()
     uses_rng: ClassVar[bool] = False
+    # stateful nodes receive their previous result (ctx.previous) and may resume
+    # from it after a local edit (regrowth) instead of starting over
+    stateful: ClassVar[bool] = False
     max_per_graph: ClassVar[int | None] = None
 
     def evaluate(self, inputs: dict[str, Any], params: dict[str, Any], ctx: EvalContext) -> dict[str, Any]:

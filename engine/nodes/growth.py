@@ -15,6 +15,8 @@ from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.graph.values import Field, LineElement, Skeleton, TilingValue
 from engine.growth import grow_tiling, list_tilesets, load_tileset, tiling_beams, tiling_image
+from engine.growth.regions import parse_region_hints, parse_region_map, region_hint_field
+from engine.growth.regrow import regrow_region
 from engine.growth.properties import VOID_MODES, homogenize_tiling
 
 from .properties import stiffness_from_result
@@ -87,6 +89,7 @@ class GrowNode(NodeType):
     code = "grow"
     family = "topology"
     uses_rng = True
+    stateful = True
     inputs = (Port("tileset", "TileSet"),)
     outputs = (Port("tiling", "Tiling"),)
     params = (
@@ -99,6 +102,11 @@ class GrowNode(NodeType):
                   "empty = the tile set's weights"),
         Param("availability", "float", 0.0, 0.0, 1e6,
               doc="blocks available per cell (paper's N); 0 = unlimited"),
+        Param("regions", "str", "",
+              doc="painted hint regions (2D): rows top to bottom separated by ';', one label "
+                  "0-9/a-z per cell, '.' = 0; empty = no regions"),
+        Param("region_hints", "str", "",
+              doc="hints per painted label, e.g. '1: T=3,+=1 | 2: L=2'; label 0 uses `hints`"),
     )
 
     def evaluate(self, inputs, params, ctx):
@@ -108,10 +116,58 @@ class GrowNode(NodeType):
             hints = parse_hints(params["hints"], ts)
         except ValueError as exc:
             raise NodeInputError(str(exc), where="hints") from None
+        field, labels = self._region_field(ts, shape, hints, params)
         availability = params["availability"] or None
-        tiling = grow_tiling(ts, shape, hints=hints, periodic=params["periodic"],
-                             availability=availability, rng=ctx.seed, progress=ctx.progress)
+        previous = ctx.previous.get("tiling") if ctx.previous else None
+        changed = self._changed_cells(previous, ts, shape, params, labels, field, ctx)
+        if changed is not None:
+            # Local regrowth (paper's repainting): only repainted cells plus a margin
+            # grow again; every other tile stays byte-identical.
+            tiling = regrow_region(previous.tiling, ts, changed, margin=1,
+                                   hints=field if field is not None else hints, rng=ctx.seed,
+                                   progress=ctx.progress)
+        else:
+            tiling = grow_tiling(ts, shape, hints=field if field is not None else hints,
+                                 periodic=params["periodic"], availability=availability, rng=ctx.seed,
+                                 progress=ctx.progress)
         return {"tiling": TilingValue(tiling, ts)}
+
+    @staticmethod
+    def _region_field(ts, shape, hints, params):
+        try:
+            labels = parse_region_map(params["regions"], shape)
+        except ValueError as exc:
+            raise NodeInputError(str(exc), where="regions") from None
+        if labels is None:
+            return None, None
+        try:
+            per_label = parse_region_hints(params["region_hints"], lambda text: parse_hints(text, ts))
+        except ValueError as exc:
+            raise NodeInputError(str(exc), where="region_hints") from None
+        return region_hint_field(ts, shape, labels, hints, per_label), labels
+
+    @staticmethod
+    def _changed_cells(previous, ts, shape, params, labels, field, ctx):
+        """Cells to regrow when only the painted regions changed since the last
+        evaluation of this node (same set, size, seed, periodicity); else None."""
+        prev_params = ctx.previous_params or {}
+        same = (previous is not None and previous.tileset is ts and previous.tiling.tiles.shape == tuple(shape)
+                and not params["availability"]
+                and all(prev_params.get(k) == params[k] for k in ("size", "periodic", "hints", "availability"))
+                and ctx.previous_seed == ctx.seed)
+        if not same:
+            return None
+        try:
+            old = parse_region_map(prev_params.get("regions", ""), shape)
+        except ValueError:
+            return None
+        old = np.zeros(shape, np.int64) if old is None else old
+        new = np.zeros(shape, np.int64) if labels is None else labels
+        if prev_params.get("region_hints") != params["region_hints"]:
+            changed = (old != new) | (new != 0) | (old != 0)
+        else:
+            changed = old != new
+        return changed if changed.any() else None
 
 
 @register
