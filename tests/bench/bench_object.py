@@ -16,6 +16,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from engine.geometry import line_sdf_grid, line_sdf_reference, periodic_mesh  # noqa: E402
+from engine.geometry.lattices import octet_segments  # noqa: E402
 from engine.geometry.marching import mesh_volume  # noqa: E402
 
 RADIUS = 0.05
@@ -25,25 +26,7 @@ def octet_truss():
     """Octet truss in one periodic cell: the 6 face diagonals of the three
     faces through the origin (the opposite faces are their periodic copies)
     and the 12 edges of the octahedron joining the face centres."""
-    segs = []
-    for axis in range(3):
-        u, v = [i for i in range(3) if i != axis]
-        a, b = np.zeros(3), np.zeros(3)
-        b[u] = b[v] = 1.0
-        c, d = np.zeros(3), np.zeros(3)
-        c[u], d[v] = 1.0, 1.0
-        segs += [(a, b), (c, d)]
-    centres = []
-    for axis in range(3):
-        for val in (0.0, 1.0):
-            p = np.full(3, 0.5)
-            p[axis] = val
-            centres.append(p)
-    for i in range(6):
-        for j in range(i + 1, 6):
-            if np.isclose(np.linalg.norm(centres[i] - centres[j]), np.sqrt(0.5)):
-                segs.append((centres[i], centres[j]))
-    return [np.array(s) for s in segs]
+    return octet_segments()
 
 
 def best_of(repeats, fn):

@@ -9,6 +9,8 @@ import itertools
 import time
 
 import numpy as np
+
+from engine.geometry.lattices import octet_segments as _octet_segments
 import pytest
 
 from engine.geometry.cancel import Cancelled
@@ -133,24 +135,7 @@ def bcc_segments():
 def octet_segments():
     """Face diagonals of the three faces through the origin (the others are
     periodic copies) and the 12 octahedron edges joining the face centres."""
-    segs = []
-    for axis in range(3):
-        u, v = [i for i in range(3) if i != axis]
-        a, b, c, d = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
-        b[u] = b[v] = 1.0
-        c[u] = d[v] = 1.0
-        segs += [(a, b), (c, d)]
-    centres = []
-    for axis in range(3):
-        for val in (0.0, 1.0):
-            p = np.full(3, 0.5)
-            p[axis] = val
-            centres.append(p)
-    for i in range(6):
-        for j in range(i + 1, 6):
-            if np.isclose(np.linalg.norm(centres[i] - centres[j]), np.sqrt(0.5)):
-                segs.append((centres[i], centres[j]))
-    return segs
+    return [tuple(seg) for seg in _octet_segments()]
 
 
 def rel_err(C, ref):
