@@ -23,6 +23,7 @@ from engine.graph.values import Solid
 
 from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
+from .growth_panel import GrowthPanel
 from .inspector import Inspector
 from .node_editor import NodeEditor
 from .viewport import Viewport, pick_display_nodes, pick_stiffness_node, skeleton_of, solid_of, stiffness_of
@@ -103,6 +104,10 @@ class MainWindow(QtWidgets.QMainWindow):
         scroll.setWidget(self.inspector)
         scroll.setMinimumWidth(300)
         self.inspector_dock = self._dock("Inspector", scroll, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.growth_panel = GrowthPanel(self)
+        self.growth_dock = self._dock("Virtual Growth", self.growth_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.growth_dock)
+        self.inspector_dock.raise_()
 
         bottom = QtWidgets.QWidget()
         lay = QtWidgets.QVBoxLayout(bottom)
@@ -214,7 +219,7 @@ class MainWindow(QtWidgets.QMainWindow):
         view_menu.addAction(self.act_arrange)
         view_menu.addAction(self.act_reset_camera)
         view_menu.addSeparator()
-        for dock in (self.editor_dock, self.inspector_dock, self.log_dock):
+        for dock in (self.editor_dock, self.inspector_dock, self.growth_dock, self.log_dock):
             view_menu.addAction(dock.toggleViewAction())
 
         eval_menu = bar.addMenu("E&valuate")
@@ -392,6 +397,7 @@ class MainWindow(QtWidgets.QMainWindow):
                               f"E_avg {stiffness.constants.get('E_avg', float('nan')):.4g})")
         self.shown_solid_id, self.shown_skeleton_id = solid_id, skel_id
         self.shown_stiffness_id = stiffness_id
+        self.growth_panel.set_context(self.doc, outputs, sel)
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
                                   skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
                                   sphere_caption=sphere_caption)
@@ -592,6 +598,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._shutting_down = True
         self._debounce.stop()
         self._autosave_timer.stop()
+        self.growth_panel.pause()
         self.worker.shutdown()
         self.editor.detach()
         self.inspector.detach()
