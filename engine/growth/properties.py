@@ -34,6 +34,8 @@ import time
 
 import numpy as np
 
+from engine.physics.elastic import is_singular
+
 from .hints import realised_probabilities
 from .render import tiling_image, tiling_voxels
 from .tiling import Tiling
@@ -47,7 +49,6 @@ VOID_MODES = ("removed", "soft")
 SOFT_VOID_MODULUS = 1e-3
 # A stiffness whose smallest eigenvalue is below this fraction of its largest
 # is a mechanism (the tiling does not connect along some direction).
-SINGULAR_RTOL = 1e-9
 DEFAULT_RESOLUTION = {2: 20, 3: 10}
 
 
@@ -153,13 +154,6 @@ def homogenize_tiling(tiling: Tiling, tileset, *, E: float = 1.0, nu: float = 0.
     grid = np.ascontiguousarray(vox.transpose(2, 1, 0), dtype=np.float64)
     return homogenize_voxels(grid, E=E, nu=nu, void_modulus=vm, tol=tol, threads=threads,
                              progress=progress)
-
-
-def is_singular(C) -> bool:
-    """True when ``C`` is (numerically) not positive definite: a mechanism."""
-    C = np.asarray(C, dtype=np.float64)
-    eig = np.linalg.eigvalsh(0.5 * (C + C.T))
-    return bool(eig[0] <= SINGULAR_RTOL * max(eig[-1], 1e-300))
 
 
 def constant_names(ndim: int) -> tuple:

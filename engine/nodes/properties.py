@@ -8,7 +8,7 @@ from engine.geometry.resample import resample_periodic
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.graph.values import Stiffness
-from engine.physics.elastic import engineering_constants, symmetry_class, zener_ratio
+from engine.physics.elastic import engineering_constants, is_singular, symmetry_class, zener_ratio
 from engine.physics.homogenize3d import homogenize_voxels
 
 
@@ -20,8 +20,7 @@ def stiffness_from_result(result, *, E, nu, rho, resolution) -> Stiffness:
     symmetry is reported as "singular" instead of failing the node.
     """
     C = np.asarray(result.C)
-    eig = np.linalg.eigvalsh(0.5 * (C + C.T))
-    if eig[0] <= 1e-9 * max(eig[-1], 1e-300):
+    if is_singular(C):
         constants, sym, zener = {}, "singular", None
     else:
         constants = engineering_constants(C)

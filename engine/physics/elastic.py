@@ -44,7 +44,7 @@ __all__ = [
     "rotate_stiffness", "compliance",
     "isotropic_stiffness", "isotropic_plane_stress",
     "engineering_constants", "voigt_reuss_moduli", "universal_anisotropy_index",
-    "symmetry_class", "zener_ratio",
+    "symmetry_class", "zener_ratio", "is_singular",
     "hashin_shtrikman_bounds", "inside_hashin_shtrikman", "BoundsCheck",
     "directional_young", "directional_young_polar",
 ]
@@ -733,3 +733,12 @@ def directional_young_polar(C, angles, *, kind="stiffness"):
     a = np.column_stack([c * c, sn * sn, c * sn])
     e = 1.0 / np.einsum("ni,ij,nj->n", a, s, a)
     return float(e[0]) if t.ndim == 0 else e.reshape(t.shape)
+
+
+def is_singular(C, rtol: float = 1e-9) -> bool:
+    """True when ``C`` is numerically not positive definite (a mechanism:
+    the cell carries no load along some strain), smallest over largest
+    eigenvalue of its symmetric part at most ``rtol``."""
+    c = np.asarray(C, dtype=np.float64)
+    eig = np.linalg.eigvalsh(0.5 * (c + c.T))
+    return bool(eig[0] <= rtol * max(eig[-1], 1e-300))

@@ -7,15 +7,9 @@ import pytest
 import trimesh
 
 from engine.physics.elastic import isotropic_plane_stress, isotropic_stiffness
+from .test_elastic import cubic
 from engine.physics.material_sphere import material_polar, material_sphere, material_sphere_polydata
 
-
-def cubic(c11, c12, c44):
-    c = np.zeros((6, 6))
-    c[:3, :3] = c12
-    c[np.arange(3), np.arange(3)] = c11
-    c[np.arange(3, 6), np.arange(3, 6)] = c44
-    return c
 
 
 def e100_e111(c11, c12, c44):
