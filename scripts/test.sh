@@ -6,4 +6,11 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh --test
 export MESOFORGE_AUTOSAVE_DIR="${MESOFORGE_AUTOSAVE_DIR:-$(mktemp -d)}"
 .venv/bin/lint-imports
-exec .venv/bin/python -m pytest -q "$@"
+if [ "$#" -gt 0 ]; then
+  exec .venv/bin/python -m pytest -q "$@"
+fi
+# The window tests run in their own process: the Dask clusters and worker
+# processes of the study tests must not share a process with the VTK/X
+# render windows (a segfault creating a render window was seen otherwise).
+.venv/bin/python -m pytest -q --ignore=tests/ui
+exec .venv/bin/python -m pytest -q -p xvfb tests/ui
