@@ -109,24 +109,35 @@ def _propagate(sp, stack, on_stack, wave, status, tiles, dirty, dlist, nbr, mask
                 if _has(wave, c, t):
                     for w in range(n_words):
                         sup[w] |= masks[d, t, w]
-            changed = False
-            empty = True
-            for w in range(n_words):
-                new = wave[nb, w] & sup[w]
-                if new != wave[nb, w]:
-                    changed = True
-                    wave[nb, w] = new
-                if new != 0:
-                    empty = False
-            if changed:
-                if empty:
-                    _mark_defect(nb, status, tiles, events, counters)
-                else:
-                    _mark_dirty(nb, dirty, dlist, counters)
-                    if not on_stack[nb]:
-                        on_stack[nb] = True
-                        stack[sp] = nb
-                        sp += 1
+            sp = _narrow(nb, sup, False, sp, stack, on_stack, wave, status, tiles, dirty, dlist,
+                         events, counters)
+    return sp
+
+
+@njit(cache=True, nogil=True)
+def _narrow(c, keep, invert, sp, stack, on_stack, wave, status, tiles, dirty, dlist, events,
+            counters):
+    """Intersect cell ``c``'s wave with ``keep`` (or its complement when
+    ``invert``); a cell left empty is a defect, a changed one is pushed for
+    propagation.  Returns the new stack size."""
+    changed = False
+    empty = True
+    for w in range(wave.shape[1]):
+        new = wave[c, w] & (~keep[w] if invert else keep[w])
+        if new != wave[c, w]:
+            changed = True
+            wave[c, w] = new
+        if new != 0:
+            empty = False
+    if changed:
+        if empty:
+            _mark_defect(c, status, tiles, events, counters)
+        else:
+            _mark_dirty(c, dirty, dlist, counters)
+            if not on_stack[c]:
+                on_stack[c] = True
+                stack[sp] = c
+                sp += 1
     return sp
 
 
@@ -138,24 +149,8 @@ def _ban_block(b, block_masks, stack, on_stack, wave, status, tiles, dirty, dlis
     for c in range(wave.shape[0]):
         if status[c] != FREE:
             continue
-        changed = False
-        empty = True
-        for w in range(wave.shape[1]):
-            new = wave[c, w] & ~block_masks[b, w]
-            if new != wave[c, w]:
-                changed = True
-                wave[c, w] = new
-            if new != 0:
-                empty = False
-        if changed:
-            if empty:
-                _mark_defect(c, status, tiles, events, counters)
-            else:
-                _mark_dirty(c, dirty, dlist, counters)
-                if not on_stack[c]:
-                    on_stack[c] = True
-                    stack[sp] = c
-                    sp += 1
+        sp = _narrow(c, block_masks[b], True, sp, stack, on_stack, wave, status, tiles, dirty,
+                     dlist, events, counters)
     _propagate(sp, stack, on_stack, wave, status, tiles, dirty, dlist, nbr, masks, events,
                counters)
 
