@@ -18,7 +18,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from engine.graph import GraphDocument, document_to_dict, load_project, write_atomic
+from engine.graph import GraphDocument, load_project, save_project, write_atomic
 
 ENV_VAR = "MESOFORGE_AUTOSAVE_DIR"
 META_SUFFIX = ".meta.json"
@@ -92,9 +92,10 @@ class AutosaveManager:
         return self.directory / f"{self.session}{META_SUFFIX}"
 
     def save(self, doc: GraphDocument, project_path: str | os.PathLike | None) -> Path:
-        """Write `doc` atomically (document first, then its sidecar)."""
-        text = json.dumps(document_to_dict(doc), indent=1, allow_nan=False)
-        write_atomic(self.autosave_path, (text + "\n").encode("utf-8"))
+        """Write `doc` atomically (document first, then its sidecar), as a
+        project file with the stateful nodes' results in ``doc.node_state``
+        (the window puts ``Evaluator.export_state()`` there first)."""
+        save_project(doc, self.autosave_path)
         now = time.time()
         meta = {
             "original_path": None if project_path is None else str(Path(project_path).resolve()),

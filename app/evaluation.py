@@ -86,10 +86,20 @@ def report_json(doc: GraphDocument, report: EvalReport) -> dict:
             if r.where:
                 entry["where"] = r.where
         nodes.append(entry)
-    return {"ok": report.ok, "seconds": round(report.seconds, 6), "cache_hits": report.cache_hits,
-            "evaluated": sum(r.status == "evaluated" for r in report.results.values()),
-            "failed": sorted(report.errors), "nodes": nodes}
+    out = {"ok": report.ok, "seconds": round(report.seconds, 6), "cache_hits": report.cache_hits,
+           "evaluated": sum(r.status == "evaluated" for r in report.results.values()),
+           "failed": sorted(report.errors), "nodes": nodes}
+    warnings = list(doc.load_warnings) + list(report.warnings.values())
+    if warnings:
+        out["warnings"] = warnings
+    return out
 
 
 def evaluate_document(doc: GraphDocument, *, on_progress=None) -> EvalReport:
-    return Evaluator().evaluate(doc, on_progress=on_progress)
+    """Evaluate `doc` in a fresh evaluator, starting from the node results stored
+    in it (a grown and repainted tiling comes back as it was saved)."""
+    evaluator = Evaluator()
+    for warning in evaluator.import_state(doc.node_state):
+        if warning not in doc.load_warnings:
+            doc.load_warnings.append(warning)
+    return evaluator.evaluate(doc, on_progress=on_progress)

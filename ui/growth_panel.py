@@ -1,33 +1,53 @@
 """The "Virtual Growth" dock: a grown tiling as an image, its growth replayed,
-its realised block probabilities and (when a Tiling Properties node follows
-it) the in-plane stiffness.
+hint regions painted on it, its realised block probabilities and (when a
+Tiling Properties node follows it) the in-plane stiffness.
 
 The panel shows the tiling of the selected node, or of the node feeding the
-selected node, or else of the last node in the graph that produced one.  The
-replay regrows the tiling with ``record_steps=True`` (same tile set, shape,
-hints, periodicity, availability and seed, so the same tiling) and reveals the
-cells in the order growth decided them; a QTimer on the GUI thread drives it.
-Everything is drawn with QPainter.
+selected node, or else of the last node in the graph that produced one. A 3D
+tiling is shown one layer at a time (axis and layer chosen below the
+picture), each block's beams projected onto the layer plane
+(``engine.growth.layers``).
+
+The replay reveals the cells in the order growth decided them, from the grid
+as it was before the growth: the ``steps`` / ``start_tiles`` the Grow node
+recorded on its output when present (so a local regrowth replays as one),
+else the tiling's own ``steps`` (start: the tiling with those cells
+cleared), else a regrowth with ``record_steps=True`` from the node's
+parameters (same tiling for a growth in one pass). A QTimer on the GUI
+thread drives it; defects show red as they form.
+
+Painting (2D Grow nodes, with an undo stack): each stroke on the picture
+becomes one ``SetParam(node, "regions", text)``, clear all one more, and the
+hints per label one ``SetParam(node, "region_hints", text)``; the panel
+follows the document's events, so undo / redo show at once.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from PySide6 import QtCore, QtGui, QtWidgets
+from PySide6 import QtCore, QtWidgets
 
+from engine.graph import SetParam
 from engine.graph.values import Stiffness, TilingValue
-from engine.growth import DEFECT, UNASSIGNED, Tiling, grow_tiling, realised_probabilities, tiling_image
+from engine.growth import UNASSIGNED, Tiling, grow_tiling, realised_probabilities, tiling_image
+from engine.growth.layers import LAYER_AXES, layer_image, tiling_layer
+from engine.growth.regions import format_region_map, parse_region_map
+
+from .growth_charts import PieChart, PolarPlot
+from .region_canvas import RegionCanvas
+from .region_tools import RegionTools
 
 SOLID_RGB = (40, 44, 52)
 VOID_RGB = (236, 236, 230)
 UNASSIGNED_RGB = (160, 160, 160)
-DEFECT_COLOUR = QtGui.QColor(220, 40, 40)
-PIE_COLOURS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#b07aa1", "#76b7b2", "#edc948",
-               "#ff9da7", "#9c755f", "#bab0ac")
+ARM_UP_RGB = (31, 119, 180)
+ARM_DOWN_RGB = (230, 140, 30)
+# layer image codes (engine.growth.layers: VOID, BEAM, ARM_UP, ARM_DOWN, NOT_GROWN) -> colour
+LAYER_RGB = np.array([VOID_RGB, SOLID_RGB, ARM_UP_RGB, ARM_DOWN_RGB, UNASSIGNED_RGB], np.uint8)
 TICK_MS = 20
 MAX_IMAGE_PX = 800  # longest side of the rendered tiling image, in pixels
+AXIS_TEXT = {"z": "z (x-y layers)", "y": "y (x-z layers)", "x": "x (y-z layers)"}
+NO_TILING = "select a Grow node (or evaluate a graph with one)"
 
 
 def tiling_of(outputs: dict) -> TilingValue | None:
@@ -60,6 +80,12 @@ def tiling_rgb(tiles: np.ndarray, tileset, tileset_name: str, periodic: bool, pp
     return np.ascontiguousarray(rgb.astype(np.uint8))
 
 
+def layer_rgb(tiles: np.ndarray, tileset, axis: str, index: int, ppb: int) -> np.ndarray:
+    """(rows*ppb, cols*ppb, 3) uint8 picture of one layer of a 3D grid."""
+    codes = layer_image(tiles, tileset, axis, index, resolution=ppb, line_width=max(1.0, ppb / 5.0))
+    return np.ascontiguousarray(LAYER_RGB[codes])
+
+
 def requested_block_hints(hints, tileset) -> np.ndarray | None:
     """Requested block probabilities (normalised), from parsed hints or the set's weights."""
     n_blocks = tileset.n_blocks
@@ -81,182 +107,68 @@ def requested_block_hints(hints, tileset) -> np.ndarray | None:
     return w / total if total > 0 else None
 
 
-class TilingView(QtWidgets.QWidget):
-    """A tiling image scaled to fit (nearest neighbour) with defect cells marked red."""
+def recorded_history(tv: TilingValue):
+    """(start grid, steps (n, 2), final grid) recorded with the tiling, or None.
 
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.image: QtGui.QImage | None = None
-        self.grid_shape: tuple = ()
-        self.defects = np.zeros((0, 2), dtype=int)  # (row, col) of defect cells
-        self.setMinimumSize(200, 200)
-        self.setSizePolicy(QtWidgets.QSizePolicy.Policy.Expanding, QtWidgets.QSizePolicy.Policy.Expanding)
-
-    def set_grid(self, rgb: np.ndarray | None, tiles: np.ndarray | None) -> None:
-        if rgb is None:
-            self.image, self.grid_shape, self.defects = None, (), np.zeros((0, 2), dtype=int)
-        else:
-            h, w, _ = rgb.shape
-            self._rgb = rgb  # the QImage borrows this buffer
-            self.image = QtGui.QImage(rgb.data, w, h, 3 * w, QtGui.QImage.Format.Format_RGB888).copy()
-            self.grid_shape = tuple(tiles.shape)
-            self.defects = np.argwhere(np.asarray(tiles) == DEFECT)
-        self.update()
-
-    def target_rect(self) -> QtCore.QRectF:
-        if self.image is None:
-            return QtCore.QRectF()
-        iw, ih = self.image.width(), self.image.height()
-        s = min((self.width() - 8) / iw, (self.height() - 8) / ih)
-        s = max(s, 1e-3)
-        w, h = iw * s, ih * s
-        return QtCore.QRectF((self.width() - w) / 2, (self.height() - h) / 2, w, h)
-
-    def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), self.palette().window())
-        if self.image is None:
-            p.setPen(self.palette().text().color())
-            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, "no tiling")
-            p.end()
-            return
-        p.setRenderHint(QtGui.QPainter.RenderHint.SmoothPixmapTransform, False)
-        r = self.target_rect()
-        p.drawImage(r, self.image)  # nearest neighbour: smooth transform is off
-        ny, nx = self.grid_shape
-        cw, ch = r.width() / nx, r.height() / ny
-        pen = QtGui.QPen(DEFECT_COLOUR, max(1.5, min(cw, ch) / 10))
-        p.setPen(pen)
-        p.setBrush(QtGui.QColor(220, 40, 40, 60))
-        inset = 0.12
-        for row, col in self.defects:
-            p.drawRect(QtCore.QRectF(r.left() + (col + inset) * cw, r.top() + (row + inset) * ch,
-                                     (1 - 2 * inset) * cw, (1 - 2 * inset) * ch))
-        p.end()
-
-
-class PieChart(QtWidgets.QWidget):
-    """Realised block probabilities as a pie with a legend (and the requested hints)."""
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.names: list[str] = []
-        self.values = np.zeros(0)
-        self.requested: np.ndarray | None = None
-        self.setMinimumHeight(130)
-
-    def set_data(self, names, values, requested=None) -> None:
-        self.names = list(names)
-        self.values = np.asarray(values, dtype=float)
-        self.requested = None if requested is None else np.asarray(requested, dtype=float)
-        self.update()
-
-    def legend_lines(self) -> list[str]:
-        lines = []
-        for k, (name, v) in enumerate(zip(self.names, self.values)):
-            text = f"{name}  {100 * v:.1f}%"
-            if self.requested is not None and k < len(self.requested):
-                text += f"  (hint {100 * self.requested[k]:.0f}%)"
-            lines.append(text)
-        return lines
-
-    def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.setRenderHint(QtGui.QPainter.RenderHint.Antialiasing)
-        if not self.names or self.values.sum() <= 0:
-            p.setPen(self.palette().text().color())
-            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, "no blocks placed")
-            p.end()
-            return
-        d = min(self.height() - 10, self.width() // 2 - 10)
-        pie = QtCore.QRectF(5, (self.height() - d) / 2, d, d)
-        start = 90 * 16
-        for k, v in enumerate(self.values):
-            span = int(round(-v * 360 * 16))
-            p.setBrush(QtGui.QColor(PIE_COLOURS[k % len(PIE_COLOURS)]))
-            p.setPen(QtGui.QPen(QtGui.QColor("white"), 1))
-            if span:
-                p.drawPie(pie, start, span)
-            start += span
-        fm = p.fontMetrics()
-        x = pie.right() + 14
-        y = max(4, (self.height() - fm.height() * len(self.names)) / 2)
-        for k, text in enumerate(self.legend_lines()):
-            p.setBrush(QtGui.QColor(PIE_COLOURS[k % len(PIE_COLOURS)]))
-            p.setPen(QtCore.Qt.PenStyle.NoPen)
-            p.drawRect(QtCore.QRectF(x, y + 3, fm.height() - 6, fm.height() - 6))
-            p.setPen(self.palette().text().color())
-            p.drawText(QtCore.QPointF(x + fm.height(), y + fm.ascent()), text)
-            y += fm.height()
-        p.end()
-
-
-class PolarPlot(QtWidgets.QWidget):
-    """E(theta) of a 2D stiffness as a closed polar curve."""
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.theta = np.zeros(0)
-        self.values = np.zeros(0)
-        self.setMinimumSize(140, 140)
-
-    def set_curve(self, theta, values) -> None:
-        self.theta = np.asarray(theta, float)
-        self.values = np.asarray(values, float)
-        self.update()
-
-    def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.setRenderHint(QtGui.QPainter.RenderHint.Antialiasing)
-        c = QtCore.QPointF(self.width() / 2, self.height() / 2)
-        radius = min(self.width(), self.height()) / 2 - 8
-        vmax = float(np.max(self.values)) if self.values.size and np.all(np.isfinite(self.values)) else 0
-        grid = QtGui.QPen(QtGui.QColor(150, 150, 150), 1, QtCore.Qt.PenStyle.DotLine)
-        p.setPen(grid)
-        for f in (0.5, 1.0):
-            p.drawEllipse(c, radius * f, radius * f)
-        p.drawLine(QtCore.QPointF(c.x() - radius, c.y()), QtCore.QPointF(c.x() + radius, c.y()))
-        p.drawLine(QtCore.QPointF(c.x(), c.y() - radius), QtCore.QPointF(c.x(), c.y() + radius))
-        if vmax > 0:
-            s = radius / vmax
-            pts = [QtCore.QPointF(c.x() + s * v * math.cos(t), c.y() - s * v * math.sin(t))
-                   for t, v in zip(self.theta, self.values)]
-            p.setPen(QtGui.QPen(QtGui.QColor("#4e79a7"), 2))
-            p.setBrush(QtGui.QColor(78, 121, 167, 50))
-            p.drawPolygon(QtGui.QPolygonF(pts))
-            p.setPen(self.palette().text().color())
-            p.drawText(QtCore.QPointF(2, self.height() - 3), f"max {vmax:.3g}")
-        p.end()
+    ``tv.steps`` / ``tv.start_tiles`` (set by the Grow node) first, then the
+    tiling's own ``steps``; without a start grid the cells named in the steps
+    are cleared from the final grid (growth decides each cell once).
+    """
+    final = np.asarray(tv.tiling.tiles)
+    steps = getattr(tv, "steps", None)
+    if steps is None:
+        steps = getattr(tv.tiling, "steps", None)
+    if steps is None:
+        return None
+    steps = np.asarray(steps)
+    if steps.ndim != 2 or steps.shape[1] != 2 or not np.issubdtype(steps.dtype, np.integer) \
+            or (steps.size and (steps[:, 0].min() < 0 or steps[:, 0].max() >= final.size)):
+        return None
+    start = getattr(tv, "start_tiles", None)
+    if start is None or np.shape(start) != final.shape:
+        start = final.copy()
+        start.reshape(-1)[steps[:, 0]] = UNASSIGNED
+    return np.array(start, dtype=np.int32), steps.astype(np.int64), final
 
 
 class GrowthPanel(QtWidgets.QWidget):
-    """Dock content: tiling image, growth replay, block probabilities, 2D stiffness."""
+    """Dock content: tiling picture with painted regions, growth replay, 3D layers,
+    block probabilities, 2D stiffness.
 
-    def __init__(self, parent=None):
+    Parameters
+    ----------
+    parent : QWidget, optional
+    undo : engine.graph.UndoStack, optional
+        Where paint strokes and region hints go; without it painting is off
+        (see `set_undo`).
+    """
+
+    def __init__(self, parent=None, *, undo=None):
         super().__init__(parent)
         self.doc = None
+        self.undo = None
+        self._watched = None
         self.node_id: str | None = None
         self.value: TilingValue | None = None
         self.stiffness: Stiffness | None = None
         self.stiffness_id: str | None = None
         self.ppb = 20
         self.image_shape: tuple = ()  # (height, width) in pixels of the shown image
-        self.shown_tiles: np.ndarray | None = None
+        self.shown_tiles: np.ndarray | None = None  # the whole grid shown (a layer of it in 3D)
         self.requested: np.ndarray | None = None
-        # replay state
-        self.replay: Tiling | None = None
-        self.replay_error = ""
-        self.anim_grid: np.ndarray | None = None
-        self.anim_pos = 0
+        self.replay_note = ""
+        self._reset_replay()
         self._carry = 0.0
 
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
-        self.caption = QtWidgets.QLabel("select a Grow node (or evaluate a graph with one)")
+        self.caption = QtWidgets.QLabel(NO_TILING)
         self.caption.setWordWrap(True)
         lay.addWidget(self.caption)
-        self.view = TilingView()
+        self.view = RegionCanvas()
+        self.view.strokeFinished.connect(self._on_stroke)
         lay.addWidget(self.view, 3)
+        lay.addWidget(self._build_layer_row())
 
         row = QtWidgets.QHBoxLayout()
         self.play_button = QtWidgets.QPushButton("Play")
@@ -273,7 +185,18 @@ class GrowthPanel(QtWidgets.QWidget):
         row.addWidget(self.speed_label)
         lay.addLayout(row)
         self.anim_label = QtWidgets.QLabel("")
+        self.anim_label.setWordWrap(True)
         lay.addWidget(self.anim_label)
+
+        self.region_tools = RegionTools()
+        self.region_tools.labelChosen.connect(self._on_label_chosen)
+        self.region_tools.radiusChanged.connect(self._on_radius)
+        self.region_tools.overlayToggled.connect(self.view.set_overlay_visible)
+        self.region_tools.clearRequested.connect(self.clear_regions)
+        self.region_tools.hintsApplied.connect(self._on_hints_applied)
+        self.view.paint_label = self.region_tools.paint_label
+        self.view.brush_radius = self.region_tools.radius.value()
+        lay.addWidget(self.region_tools)
 
         lay.addWidget(QtWidgets.QLabel("<b>Realised block probabilities</b>"))
         self.pie = PieChart()
@@ -293,11 +216,149 @@ class GrowthPanel(QtWidgets.QWidget):
         self.timer.setInterval(TICK_MS)
         self.timer.timeout.connect(self._tick)
         self._set_controls_enabled(False)
+        self.set_undo(undo)
+
+    def _build_layer_row(self) -> QtWidgets.QWidget:
+        self.layer_row = QtWidgets.QWidget()
+        h = QtWidgets.QHBoxLayout(self.layer_row)
+        h.setContentsMargins(0, 0, 0, 0)
+        h.addWidget(QtWidgets.QLabel("Layers along"))
+        self.layer_axis = QtWidgets.QComboBox()
+        for axis in LAYER_AXES:
+            self.layer_axis.addItem(AXIS_TEXT[axis], axis)
+        self.layer_axis.currentIndexChanged.connect(self._on_layer_axis)
+        h.addWidget(self.layer_axis)
+        self.layer_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.layer_slider.setRange(0, 0)
+        self.layer_slider.valueChanged.connect(self._on_layer)
+        h.addWidget(self.layer_slider, 1)
+        self.layer_label = QtWidgets.QLabel("")
+        h.addWidget(self.layer_label)
+        key = QtWidgets.QLabel(f"<span style='color:rgb{ARM_UP_RGB}'>&#9679;</span> up "
+                               f"<span style='color:rgb{ARM_DOWN_RGB}'>&#9679;</span> down")
+        h.addWidget(key)
+        self.layer_row.setToolTip("a 3D tiling is shown layer by layer: beams in the layer plane as "
+                                  "lines, beams to the next layer as small blue discs, to the "
+                                  "previous layer as larger orange discs")
+        self.layer_row.hide()
+        return self.layer_row
+
+    # -- document and undo --------------------------------------------------------------------
+    def set_undo(self, undo) -> None:
+        """Where paint strokes go (an UndoStack over the shown document); None turns painting off."""
+        self.undo = undo
+        if undo is not None:
+            self._watch(undo.doc)
+        self._refresh_regions()
+
+    def _watch(self, doc) -> None:
+        """Follow `doc`'s events (parameter edits, undo) to keep the painted map current."""
+        if doc is self._watched:
+            return
+        if self._watched is not None:
+            self._watched.unsubscribe(self._on_doc_event)
+        self._watched = doc
+        if doc is not None:
+            callback = self._on_doc_event
+            doc.subscribe(callback)
+            self.destroyed.connect(lambda *_: doc.unsubscribe(callback))
+
+    def _on_doc_event(self, event: str, payload) -> None:
+        try:
+            if event == "param_changed":
+                node_id, name = payload
+                if node_id == self.node_id and name in ("regions", "region_hints", "hints", "size"):
+                    self._refresh_regions()
+            elif event in ("node_removed", "reset"):
+                self._refresh_regions()
+        except RuntimeError:   # the widget is gone; the document lives on
+            pass
+
+    def _grow_node(self):
+        doc = self.doc if self.doc is not None else self._watched
+        node = doc.nodes.get(self.node_id) if doc is not None and self.node_id else None
+        return node if node is not None and node.type_name == "Grow" else None
+
+    def paint_block_reason(self) -> str | None:
+        """Why painting is off now, or None when it is on."""
+        node = self._grow_node()
+        if self.value is None:
+            return "painting needs a tiling: evaluate a graph with a Grow node"
+        if node is None:
+            return "hint regions are painted on the tiling of a Grow node"
+        if self.value.ndim != 2:
+            return "painted regions are for 2D grids; this tiling is 3D"
+        if self.undo is None:
+            return "painting is off: the panel has no undo history to record strokes"
+        if self.doc is not None and self.undo.doc is not self.doc:
+            return "painting is off: the undo history belongs to another document"
+        size = tuple(int(s) for s in node.params.get("size", ()))[::-1]
+        if size != tuple(self.value.tiling.shape):
+            return "the grid size changed since the last evaluation: evaluate to paint"
+        return None
+
+    def _refresh_regions(self) -> None:
+        reason = self.paint_block_reason()
+        node = self._grow_node()
+        labels, problem = None, ""
+        if node is not None and self.value is not None and self.value.ndim == 2:
+            try:
+                labels = parse_region_map(node.params.get("regions", ""), self.value.tiling.shape)
+            except ValueError as exc:
+                problem = f"the regions text does not fit this grid ({exc}); a stroke replaces it"
+        self.view.set_labels(labels)
+        self.view.set_painting(reason is None)
+        self.view.setToolTip(reason or "")
+        self.region_tools.set_available(reason)
+        if node is not None and self.value is not None and self.value.ndim == 2:
+            self.region_tools.set_state(labels, node.params.get("region_hints", ""),
+                                        node.params.get("hints", ""), self.value.tileset)
+        else:
+            self.region_tools.set_state(None, "", "", None)
+        if problem:
+            self.region_tools.show_message(problem, error=True)
+
+    def _push_param(self, name: str, value: str) -> bool:
+        try:
+            self.undo.push(SetParam(self.node_id, name, value))
+        except Exception as exc:   # refused by the document: nothing changed
+            self.region_tools.show_message(f"not applied: {exc}", error=True)
+            self._refresh_regions()
+            return False
+        return True
+
+    def _on_stroke(self, labels: np.ndarray) -> None:
+        if self.paint_block_reason() is not None:
+            self._refresh_regions()
+            return
+        self._push_param("regions", format_region_map(labels) if np.any(labels) else "")
+
+    def clear_regions(self) -> None:
+        """Remove every painted region: one undo step (nothing if nothing is painted)."""
+        node = self._grow_node()
+        if node is None or self.paint_block_reason() is not None:
+            return
+        if not node.params.get("regions", "").strip():
+            self.region_tools.show_message("nothing is painted")
+            return
+        self._push_param("regions", "")
+
+    def _on_hints_applied(self, text: str) -> None:
+        if self._grow_node() is not None and self.paint_block_reason() is None:
+            if self._push_param("region_hints", text):
+                self.region_tools.show_message("hints applied")
+
+    def _on_label_chosen(self, label: int) -> None:
+        self.view.paint_label = int(label)
+
+    def _on_radius(self, radius: float) -> None:
+        self.view.brush_radius = float(radius)
 
     # -- context ------------------------------------------------------------------------------
     def set_context(self, doc, outputs: dict, selected: str | None) -> None:
         """Pick the tiling to show from the latest evaluation outputs and the selection."""
         self.doc = doc
+        self._watch(doc if doc is not None else getattr(self.undo, "doc", None))
         outputs = {k: v for k, v in (outputs or {}).items() if doc is None or k in doc.nodes}
         node_id = self._pick_node(doc, outputs, selected)
         value = tiling_of(outputs[node_id]) if node_id else None
@@ -308,6 +369,7 @@ class GrowthPanel(QtWidgets.QWidget):
         self.stiffness_id, self.stiffness = stiffness_id, stiffness
         self._show_tiling()
         self._show_stiffness()
+        self._refresh_regions()
 
     @staticmethod
     def _pick_node(doc, outputs, selected):
@@ -341,10 +403,11 @@ class GrowthPanel(QtWidgets.QWidget):
     # -- tiling ---------------------------------------------------------------------------------
     def _show_tiling(self) -> None:
         self.pause()
-        self.replay, self.replay_error, self.anim_grid, self.anim_pos = None, "", None, 0
+        self._reset_replay()
         tv = self.value
         if tv is None:
-            self.caption.setText("select a Grow node (or evaluate a graph with one)")
+            self.caption.setText(NO_TILING)
+            self.layer_row.hide()
             self._set_image(None)
             self.pie.set_data([], [])
             self.anim_label.setText("")
@@ -356,32 +419,67 @@ class GrowthPanel(QtWidgets.QWidget):
                              f"periodic: {'yes' if t.periodic else 'no'}, "
                              f"defects: {t.n_defects}, seed: {t.seed}")
         self.ppb = pixels_per_block(t.shape)
-        if tv.ndim == 2:
-            self._set_image(np.asarray(t.tiles))
-            self._set_controls_enabled(True)
-        else:
-            self._set_image(None)
-            self._set_controls_enabled(False)
-        self.anim_label.setText("" if tv.ndim == 2 else "3D tiling: the image and replay are 2D only")
-        hints, _ = self._node_hints()
-        self.requested = requested_block_hints(hints, tv.tileset) if hints is not False else None
+        self.layer_row.setVisible(tv.ndim == 3)
+        if tv.ndim == 3:
+            self._fit_layer_slider()
+        self._set_image(np.asarray(t.tiles))
+        self._set_controls_enabled(True)
+        self.anim_label.setText("")
+        self.requested = self._requested_blocks()
         self.pie.set_data(tv.tileset.block_names, realised_probabilities(t, tv.tileset), self.requested)
 
+    @property
+    def axis(self) -> str:
+        return self.layer_axis.currentData() or "z"
+
+    @property
+    def layer(self) -> int:
+        return int(self.layer_slider.value())
+
+    def set_layer(self, axis: str, index: int) -> None:
+        """Show layer `index` along `axis` ("z", "y" or "x") of a 3D tiling."""
+        self.layer_axis.setCurrentIndex(list(LAYER_AXES).index(axis))
+        self.layer_slider.setValue(int(index))
+
+    def _fit_layer_slider(self) -> None:
+        n = self.value.tiling.shape[LAYER_AXES[self.axis][0]]
+        self.layer_slider.blockSignals(True)
+        self.layer_slider.setRange(0, n - 1)
+        self.layer_slider.setValue(min(self.layer_slider.value(), n - 1))
+        self.layer_slider.blockSignals(False)
+        self.layer_label.setText(f"{self.axis} = {self.layer} / {n - 1}")
+
+    def _on_layer_axis(self, _index: int) -> None:
+        if self.value is not None and self.value.ndim == 3:
+            self._fit_layer_slider()
+            self._set_image(self.shown_tiles)
+
+    def _on_layer(self, _value: int) -> None:
+        if self.value is not None and self.value.ndim == 3:
+            self._fit_layer_slider()
+            self._set_image(self.shown_tiles)
+
     def _set_image(self, tiles: np.ndarray | None) -> None:
+        """Show the whole grid `tiles` (one layer of it in 3D); None clears."""
         if tiles is None:
             self.shown_tiles, self.image_shape = None, ()
             self.view.set_grid(None, None)
             return
         tv = self.value
-        rgb = tiling_rgb(tiles, tv.tileset, tv.tiling.tileset_name, tv.tiling.periodic, self.ppb)
         self.shown_tiles = np.array(tiles)
+        if self.shown_tiles.ndim == 2:
+            rgb = tiling_rgb(tiles, tv.tileset, tv.tiling.tileset_name, tv.tiling.periodic, self.ppb)
+            cells = self.shown_tiles
+        else:
+            rgb = layer_rgb(self.shown_tiles, tv.tileset, self.axis, self.layer, self.ppb)
+            cells = tiling_layer(self.shown_tiles, self.axis, self.layer)
         self.image_shape = rgb.shape[:2]
-        self.view.set_grid(rgb, self.shown_tiles)
+        self.view.set_grid(rgb, cells)
 
     def _node_hints(self):
         """(parsed hints or None, availability or None); hints False if unknown / unparsable."""
-        node = self.doc.nodes.get(self.node_id) if self.doc is not None and self.node_id else None
-        if node is None or node.type_name != "Grow":
+        node = self._grow_node()
+        if node is None:
             return False, None
         try:
             from engine.batch.hints_text import parse_hints
@@ -389,6 +487,48 @@ class GrowthPanel(QtWidgets.QWidget):
         except ValueError:
             return False, None
         return hints, (node.params.get("availability") or None)
+
+    def _requested_blocks(self) -> np.ndarray | None:
+        """Block probabilities the node asks for, averaged over the painted cells' hints."""
+        hints, _ = self._node_hints()
+        if hints is False:
+            return None
+        ts = self.value.tileset
+        regions = self._grow_node().params.get("regions", "")
+        if self.value.ndim != 2 or not regions.strip():
+            return requested_block_hints(hints, ts)
+        from engine.batch.hints_text import parse_hints
+        from engine.growth.regions import parse_region_hints
+        try:
+            counts = np.bincount(parse_region_map(regions, self.value.tiling.shape).ravel())
+            per_label = parse_region_hints(self._grow_node().params.get("region_hints", ""),
+                                           lambda text: parse_hints(text, ts))
+        except ValueError:
+            return None
+        total = np.zeros(ts.n_blocks)
+        for label in np.flatnonzero(counts):
+            share = requested_block_hints(per_label.get(int(label), hints), ts)
+            if share is None:
+                return None
+            total += counts[label] * share
+        return total / total.sum()
+
+    def _growth_hints(self):
+        """Hints the Grow node passes to growth: its base hints or the painted field; False if unknown."""
+        hints, _ = self._node_hints()
+        node = self._grow_node()
+        if hints is False or self.value.ndim != 2 or not node.params.get("regions", "").strip():
+            return hints
+        from engine.batch.hints_text import parse_hints
+        from engine.growth.regions import parse_region_hints, region_hint_field
+        ts, shape = self.value.tileset, self.value.tiling.shape
+        try:
+            labels = parse_region_map(node.params["regions"], shape)
+            per_label = parse_region_hints(node.params.get("region_hints", ""),
+                                           lambda text: parse_hints(text, ts))
+        except ValueError:
+            return False
+        return region_hint_field(ts, shape, labels, hints, per_label)
 
     def _show_stiffness(self) -> None:
         st = self.stiffness
@@ -408,6 +548,15 @@ class GrowthPanel(QtWidgets.QWidget):
         self.stiffness_box.show()
 
     # -- replay -----------------------------------------------------------------------------------
+    def _reset_replay(self) -> None:
+        self.replay_start: np.ndarray | None = None
+        self.replay_steps: np.ndarray | None = None
+        self.replay_final: np.ndarray | None = None
+        self.replay_error = ""
+        self.replay_note = ""
+        self.anim_grid: np.ndarray | None = None
+        self.anim_pos = 0
+
     def _set_controls_enabled(self, on: bool) -> None:
         self.play_button.setEnabled(on)
         self.speed.setEnabled(on)
@@ -416,48 +565,63 @@ class GrowthPanel(QtWidgets.QWidget):
         self.speed_label.setText(f"{value} steps/s")
 
     def prepare_replay(self) -> bool:
-        """Regrow the shown tiling with its steps recorded; False (with a note) if impossible."""
-        if self.replay is not None:
+        """Find (or rebuild) the shown tiling's growth history; False (with a note) if impossible."""
+        if self.replay_steps is not None:
             return True
         tv = self.value
-        if tv is None or tv.ndim != 2:
+        if tv is None:
             return False
+        history = recorded_history(tv)
+        if history is None:
+            history = self._regrown_history()
+            if history is None:
+                return False
+        else:
+            cleared = int(np.count_nonzero(history[0] == UNASSIGNED))
+            self.replay_note = ("recorded growth" if cleared == tv.tiling.tiles.size
+                                else f"recorded local regrowth of {cleared} cells")
+        self.replay_start, self.replay_steps, self.replay_final = history
+        self.anim_grid = self.replay_start.copy()
+        self.anim_pos = 0
+        return True
+
+    def _regrown_history(self):
+        """Grow the tiling again from the node's parameters with its steps recorded."""
+        tv = self.value
         t = tv.tiling
-        hints, availability = self._node_hints()
+        _, availability = self._node_hints()
+        hints = self._growth_hints()
         if hints is False or t.seed is None:
             self.replay_error = "cannot replay: the growth parameters are not known"
             self.anim_label.setText(self.replay_error)
-            return False
+            return None
         try:
             replay = grow_tiling(tv.tileset, t.shape, hints=hints, periodic=t.periodic,
                                  availability=availability, rng=t.seed, record_steps=True)
         except Exception as exc:
             self.replay_error = f"cannot replay: {exc}"
             self.anim_label.setText(self.replay_error)
-            return False
+            return None
         if not np.array_equal(replay.tiles, t.tiles):
-            self.replay_error = ("the shown tiling was not grown in one pass from the node's current "
-                                 "parameters (painted regions, local regrowth or an edit): the replay "
-                                 "shows a fresh growth")
-            self.anim_label.setText(self.replay_error)
-        self.replay = replay
-        self.anim_grid = np.full(t.shape, UNASSIGNED, dtype=np.int32)
-        self.anim_pos = 0
-        return True
+            self.replay_note = ("the shown tiling was not grown in one pass from the node's current "
+                                "parameters (local regrowth or an edit) and carries no record: "
+                                "the replay shows a fresh growth")
+        start = np.full(t.shape, UNASSIGNED, dtype=np.int32)
+        return start, np.asarray(replay.steps, dtype=np.int64), np.asarray(replay.tiles)
 
     @property
     def n_steps(self) -> int:
-        return 0 if self.replay is None else len(self.replay.steps)
+        return 0 if self.replay_steps is None else len(self.replay_steps)
 
     def assigned_count(self) -> int:
-        """Cells shown as decided (tile or defect) in the current image."""
+        """Cells shown as decided (tile or defect) in the whole shown grid."""
         if self.shown_tiles is None:
             return 0
         return int(np.count_nonzero(self.shown_tiles != UNASSIGNED))
 
     def restart(self) -> None:
         if self.prepare_replay():
-            self.anim_grid[...] = UNASSIGNED
+            self.anim_grid[...] = self.replay_start
             self.anim_pos = 0
             self._set_image(self.anim_grid)
             self._update_anim_label()
@@ -466,7 +630,7 @@ class GrowthPanel(QtWidgets.QWidget):
         """Reveal the next `n` growth events; returns the number of assigned cells shown."""
         if not self.prepare_replay():
             return self.assigned_count()
-        steps = self.replay.steps
+        steps = self.replay_steps
         end = min(len(steps), self.anim_pos + max(0, int(n)))
         if end > self.anim_pos:
             chunk = steps[self.anim_pos:end]
@@ -474,14 +638,17 @@ class GrowthPanel(QtWidgets.QWidget):
             flat[chunk[:, 0]] = chunk[:, 1]  # later events win, as in the growth
             self.anim_pos = end
             if self.anim_pos == len(steps):
-                self.anim_grid[...] = self.replay.tiles  # exactly the grown tiling
+                self.anim_grid[...] = self.replay_final  # exactly the grown tiling
             self._set_image(self.anim_grid)
         self._update_anim_label()
         return self.assigned_count()
 
     def _update_anim_label(self) -> None:
-        self.anim_label.setText(f"growth step {self.anim_pos} / {self.n_steps}, "
-                                f"{self.assigned_count()} cells assigned")
+        text = (f"growth step {self.anim_pos} / {self.n_steps}, "
+                f"{self.assigned_count()} cells assigned")
+        if self.replay_note:
+            text += f" ({self.replay_note})"
+        self.anim_label.setText(text)
 
     @property
     def playing(self) -> bool:
@@ -492,7 +659,7 @@ class GrowthPanel(QtWidgets.QWidget):
             self.play_button.setChecked(False)
             return
         if self.anim_pos == 0 or self.anim_pos >= self.n_steps:
-            self.restart()  # start from the empty (grey) grid
+            self.restart()  # start from the grid before the growth
         self._carry = 0.0
         self.timer.start()
         if not self.play_button.isChecked():

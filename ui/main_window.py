@@ -24,6 +24,7 @@ from engine.graph.values import Solid
 from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
 from .growth_panel import GrowthPanel
+from .tileset_editor import TileSetEditor
 from .inspector import Inspector
 from .node_editor import NodeEditor
 from .viewport import Viewport, pick_display_nodes, pick_stiffness_node, skeleton_of, solid_of, stiffness_of
@@ -104,9 +105,13 @@ class MainWindow(QtWidgets.QMainWindow):
         scroll.setWidget(self.inspector)
         scroll.setMinimumWidth(300)
         self.inspector_dock = self._dock("Inspector", scroll, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
-        self.growth_panel = GrowthPanel(self)
+        self.growth_panel = GrowthPanel(self, undo=self.undo)
         self.growth_dock = self._dock("Virtual Growth", self.growth_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.growth_dock)
+        self.tileset_editor = TileSetEditor(self.doc, self.undo, self)
+        self.tileset_dock = self._dock("Tile Sets", self.tileset_editor, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.tileset_dock)
+        self.tileset_editor.message.connect(self.log)
         self.inspector_dock.raise_()
 
         bottom = QtWidgets.QWidget()
@@ -370,10 +375,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.log("info", f"{head} — " + "; ".join(parts) if parts else head)
         for nid, err in report.errors.items():
             self.log("error", err)
+        for warning in report.warnings.values():
+            self.log("warning", warning)
 
     # -- viewport -----------------------------------------------------------------------------
     def _on_selection_changed(self, node_id) -> None:
         self.inspector.set_node(node_id)
+        self.tileset_editor.set_selected(node_id)
         self.update_viewport()
 
     def update_viewport(self) -> None:
@@ -411,6 +419,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self._generation += 1
         self.last_report = None
         self.doc.replace_with(new_doc)
+        # stateful nodes (a repainted Grow) resume from the results stored in the file;
+        # this also drops the replaced document's, which its node ids must not inherit
+        state_warnings = self.worker.evaluator.import_state(self.doc.node_state)
+        for warning in [*new_doc.load_warnings, *state_warnings]:
+            self.log("warning", warning)
         self.undo.clear()
         self.project_path = path
         self.display_name = name
@@ -429,6 +442,11 @@ class MainWindow(QtWidgets.QMainWindow):
         if answer == "save":
             return self.save()
         return answer == "discard"
+
+    def _tileset_edits_may_go(self) -> bool:
+        """Unsaved edits in the Tile Sets dock are only dropped when the user says so."""
+        return not self.tileset_editor.unsaved or self.tileset_editor.confirm(
+            "Unsaved tile set", "The Tile Sets dock has unsaved edits. Quit and discard them?")
 
     def new_project(self) -> bool:
         if not self.maybe_save():
@@ -485,8 +503,13 @@ class MainWindow(QtWidgets.QMainWindow):
                 return False
         return self._write(Path(path))
 
+    def _take_node_state(self) -> None:
+        """Put the evaluator's stateful-node results into the document before writing it."""
+        self.doc.node_state = self.worker.evaluator.export_state()
+
     def _write(self, path: Path) -> bool:
         try:
+            self._take_node_state()
             save_project(self.doc, path)
         except (OSError, ValueError) as exc:
             self.show_error("Cannot save project", f"cannot save {str(path)!r}: {exc}")
@@ -541,6 +564,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if not self.is_modified:
             return False
         try:
+            self._take_node_state()
             self.autosave.save(self.doc, self.project_path)
         except (OSError, ValueError) as exc:
             self.log("warning", f"autosave failed: {exc}")
@@ -585,7 +609,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # -- closing ---------------------------------------------------------------------------
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:
-        if not self._shutting_down and not self.maybe_save():
+        if not self._shutting_down and not (self.maybe_save() and self._tileset_edits_may_go()):
             event.ignore()
             return
         self.shutdown()

@@ -59,6 +59,10 @@ class GraphDocument:
         self.nodes: dict[str, NodeInstance] = {}
         self.edges: list[Edge] = []
         self.meta: dict[str, Any] = {}
+        # stored results of stateful nodes, {node id: entry} (engine.graph.node_state);
+        # whoever saves fills it from Evaluator.export_state, whoever opens imports it
+        self.node_state: dict[str, dict] = {}
+        self.load_warnings: list[str] = []  # what loading the project file dropped, and why
         self._listeners: list[Callable[[str, Any], None]] = []
         self._counters: dict[str, int] = {}
 
@@ -143,6 +147,7 @@ class GraphDocument:
             raise GraphError(f"node {node_id!r} still has connections", node=node_id)
         index = list(self.nodes).index(node_id)
         del self.nodes[node_id]
+        self.node_state.pop(node_id, None)
         self.emit("node_removed", node_id)
         return node, index
 
@@ -226,6 +231,8 @@ class GraphDocument:
         self.nodes = other.nodes
         self.edges = other.edges
         self.meta = other.meta
+        self.node_state = other.node_state
+        self.load_warnings = other.load_warnings
         self._counters = {}
         self.emit("reset", None)
 

@@ -6,12 +6,19 @@ its inputs in connection order.  Editing one parameter changes the key of
 that node and of everything downstream, and nothing else, so only those
 re-run.  A failing node records its error; nodes below it are blocked; caches
 above it stay.
+
+Stateful nodes (``NodeType.stateful``) also keep their last result, which the
+next evaluation hands them as ``ctx.previous``.  `export_state` encodes those
+results for the project file and `import_state` takes them back: a stored
+result whose key equals the node's key now is used as the node's output (no
+re-evaluation); one whose key differs is still offered as ``ctx.previous``.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import threading
 import time
 from collections import OrderedDict
@@ -21,6 +28,9 @@ from typing import Any, Callable
 from .document import GraphDocument, GraphSnapshot, topological_order
 from .errors import GraphError
 from .node import Cancelled, CancelToken, EvalContext, node_seed, node_type
+from .node_state import StoredState, parse_state_entry
+
+log = logging.getLogger(__name__)
 
 # Node statuses in a report.
 EVALUATED, CACHED, FAILED, BLOCKED, CANCELLED = "evaluated", "cached", "failed", "blocked", "cancelled"
@@ -34,6 +44,7 @@ class NodeResult:
     error: str = ""
     where: str = ""
     key: str = ""
+    warning: str = ""  # e.g. a stored state that could not be restored (the node still ran)
 
 
 @dataclass
@@ -60,6 +71,10 @@ class EvalReport:
     def errors(self) -> dict[str, str]:
         return {n: r.error for n, r in self.results.items() if r.status == FAILED}
 
+    @property
+    def warnings(self) -> dict[str, str]:
+        return {n: r.warning for n, r in self.results.items() if r.warning}
+
     def output(self, node_id: str, port: str | None = None) -> Any:
         outs = self.outputs[node_id]
         if port is None:
@@ -68,7 +83,21 @@ class EvalReport:
 
 
 def _canonical(obj: Any) -> str:
+    # sorted keys, fixed separators and repr-exact floats: the same text (and
+    # so the same sha256) in every process, whatever PYTHONHASHSEED is
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+@dataclass
+class _Held:
+    """A stateful node's last result (what ``ctx.previous`` is built from)."""
+
+    type_name: str
+    key: str
+    params: dict
+    seed: int
+    outputs: dict
+    blob: dict | None = None  # encode_state(outputs), made once when first exported
 
 
 def check_required_inputs(snapshot: GraphSnapshot, node_id: str) -> None:
@@ -85,18 +114,84 @@ class Evaluator:
 
     One evaluation at a time (a lock serialises calls); the cache holds at
     most `max_entries` node results, least recently used dropped first.
+    `export_state` / `import_state` never wait for a running evaluation.
     """
 
     def __init__(self, max_entries: int = 512):
         self._cache: OrderedDict[str, dict[str, Any]] = OrderedDict()
         self.max_entries = max_entries
         self._lock = threading.Lock()
-        self._state: dict[str, tuple[dict, int, dict]] = {}  # stateful node id -> (params, seed, outputs)
+        # Stateful nodes' results.  The evaluating thread changes these (and
+        # `import_state` sets `_pending`) only under `_state_lock`.
+        self._state_lock = threading.Lock()
+        self._state: dict[str, _Held] = {}             # evaluated (or restored) this session
+        self._stored: dict[str, StoredState] = {}      # imported, not yet taken up by its node
+        self._pending: dict[str, StoredState] | None = None  # imported, applied at the next evaluate
 
     def clear(self) -> None:
-        with self._lock:
+        with self._lock, self._state_lock:
             self._cache.clear()
             self._state.clear()
+            self._stored.clear()
+            self._pending = None
+
+    # -- stored state -----------------------------------------------------
+    def import_state(self, states: dict[str, Any]) -> list[str]:
+        """Take stateful nodes' stored results (``{node_id: entry}``, see
+        `engine.graph.node_state`) in place of everything held so far.
+
+        Applied when the next evaluation starts (a running one is not
+        disturbed); the cache is emptied then too, because a restored result
+        may differ from a cached one under the same key.  Malformed entries
+        are dropped; the returned list says which and why.
+        """
+        entries: dict[str, StoredState] = {}
+        warnings = []
+        for nid, entry in (states or {}).items():
+            try:
+                entries[str(nid)] = parse_state_entry(entry)
+            except ValueError as exc:
+                warnings.append(f"node {nid!r}: stored state dropped: {exc}")
+        with self._state_lock:
+            self._pending = entries
+        return warnings
+
+    def export_state(self) -> dict[str, dict]:
+        """``{node_id: {"key", "params", "seed", "value"}}`` for every stateful
+        node result held, including imported ones no evaluation has used yet.
+        Nodes whose type cannot encode its outputs are left out."""
+        with self._state_lock:
+            if self._pending is not None:
+                held, stored = {}, dict(self._pending)
+            else:
+                held, stored = dict(self._state), dict(self._stored)
+        out = {nid: s.to_dict() for nid, s in stored.items()}
+        for nid, h in held.items():
+            if h.blob is None:
+                try:
+                    h.blob = node_type(h.type_name)().encode_state(h.outputs)
+                except Exception:  # a bug in one node's encoder must not stop a save
+                    log.exception("cannot encode the state of node %r (%s)", nid, h.type_name)
+                    continue
+            if h.blob is not None:
+                out[nid] = StoredState(h.key, h.params, h.seed, h.blob).to_dict()
+        return out
+
+    def _apply_pending(self) -> None:
+        with self._state_lock:
+            if self._pending is None:
+                return
+            self._cache.clear()
+            self._state, self._stored, self._pending = {}, self._pending, None
+
+    def _hold(self, nid: str, held: _Held) -> None:
+        with self._state_lock:
+            self._state[nid] = held
+            self._stored.pop(nid, None)
+
+    def _drop_stored(self, nid: str) -> None:
+        with self._state_lock:
+            self._stored.pop(nid, None)
 
     def _cache_get(self, key: str):
         v = self._cache.get(key)
@@ -146,6 +241,7 @@ class Evaluator:
 
     def _evaluate(self, snap, targets, cancel, on_progress, on_node_done) -> EvalReport:
         t_start = time.perf_counter()
+        self._apply_pending()
         report = EvalReport()
         keys: dict[str, str] = {}
         for nid in self._needed(snap, targets):
@@ -177,13 +273,16 @@ class Evaluator:
             "t": type_name, "v": cls.version, "p": params,
             "in": {port: [[keys[e.src], e.src_port] for e in es] for port, es in edges_by_port.items()},
         }
+        token = cls.source_token(params)
+        if token:
+            key_src["source"] = token
         if cls.uses_rng:
             key_src["seed"] = [snap.seed, nid]
         key = hashlib.sha256(_canonical(key_src).encode()).hexdigest()
         cached = self._cache_get(key)
         if cached is not None:
             if cls.stateful:
-                self._state[nid] = (params, node_seed(snap.seed, nid), cached)
+                self._hold(nid, _Held(type_name, key, params, node_seed(snap.seed, nid), cached))
             keys[nid] = key
             report.outputs[nid] = cached
             return NodeResult(nid, CACHED, key=key)
@@ -192,28 +291,55 @@ class Evaluator:
             vals = [report.outputs[e.src][e.src_port] for e in edges_by_port[port.name]]
             inputs[port.name] = vals if port.multi else (vals[0] if vals else None)
         ctx = EvalContext(nid, snap.seed, cancel=cancel, report=on_progress)
-        if cls.stateful and nid in self._state:
-            ctx.previous_params, ctx.previous_seed, ctx.previous = self._state[nid]
+        warning = ""
+        stored = self._stored.get(nid) if cls.stateful else None
+        if stored is not None:
+            restored, warning = self._restore(cls, nid, stored, inputs)
+            if restored is not None and stored.key == key:
+                self._cache_put(key, restored)
+                self._hold(nid, _Held(type_name, key, params, stored.seed, restored, stored.value))
+                keys[nid] = key
+                report.outputs[nid] = restored
+                return NodeResult(nid, CACHED, key=key)
+            if restored is not None:  # the graph changed since: the node decides what to keep
+                ctx.previous_params, ctx.previous_seed, ctx.previous = stored.params, stored.seed, restored
+        elif cls.stateful and nid in self._state:
+            held = self._state[nid]
+            ctx.previous_params, ctx.previous_seed, ctx.previous = held.params, held.seed, held.outputs
         t0 = time.perf_counter()
         try:
             ctx.check()
             outputs = cls().evaluate(inputs, params, ctx)
             ctx.check()
         except Cancelled as exc:
-            return NodeResult(nid, CANCELLED, time.perf_counter() - t0, error=str(exc))
+            return NodeResult(nid, CANCELLED, time.perf_counter() - t0, error=str(exc), warning=warning)
         except Exception as exc:  # a node failure is recorded, never thrown
             where = getattr(exc, "where", "") or ""
             msg = str(exc) if isinstance(exc, (GraphError, ValueError)) else f"{type(exc).__name__}: {exc}"
             if not msg.startswith("node "):
                 msg = f"node {nid!r} ({type_name}): {msg}"
-            return NodeResult(nid, FAILED, time.perf_counter() - t0, error=msg, where=where)
+            return NodeResult(nid, FAILED, time.perf_counter() - t0, error=msg, where=where, warning=warning)
         missing = [p.name for p in cls.outputs if p.name not in outputs]
         if missing:
             return NodeResult(nid, FAILED, time.perf_counter() - t0,
                               error=f"node {nid!r} ({type_name}) produced no value for {missing}")
         self._cache_put(key, outputs)
         if cls.stateful:
-            self._state[nid] = (params, ctx.seed, outputs)
+            self._hold(nid, _Held(type_name, key, params, ctx.seed, outputs))
         keys[nid] = key
         report.outputs[nid] = outputs
-        return NodeResult(nid, EVALUATED, time.perf_counter() - t0, key=key)
+        return NodeResult(nid, EVALUATED, time.perf_counter() - t0, key=key, warning=warning)
+
+    def _restore(self, cls, nid: str, stored: StoredState, inputs: dict) -> tuple[dict | None, str]:
+        """Decode a stored result against the node's inputs: (outputs, "") or,
+        when it does not decode, (None, why) and the stored state is dropped."""
+        try:
+            outputs = cls().decode_state(stored.value, inputs)
+            missing = [p.name for p in cls.outputs if p.name not in (outputs or {})]
+            if missing:
+                raise ValueError(f"no value for {missing}")
+        except Exception as exc:  # a bad blob in a file costs the history, never the node
+            self._drop_stored(nid)
+            return None, (f"node {nid!r} ({cls.type_name}): the result stored in the project could not "
+                          f"be restored ({exc}); evaluated from scratch")
+        return outputs, ""

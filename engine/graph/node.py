@@ -119,12 +119,32 @@ class NodeType:
     params: ClassVar[tuple[Param, ...]] = ()
     uses_rng: ClassVar[bool] = False
     # stateful nodes receive their previous result (ctx.previous) and may resume
-    # from it after a local edit (regrowth) instead of starting over
+    # from it after a local edit (regrowth) instead of starting over; with
+    # encode_state / decode_state that result is also kept in the project file
     stateful: ClassVar[bool] = False
     max_per_graph: ClassVar[int | None] = None
 
     def evaluate(self, inputs: dict[str, Any], params: dict[str, Any], ctx: EvalContext) -> dict[str, Any]:
         raise NotImplementedError
+
+    @classmethod
+    def source_token(cls, params: dict[str, Any]) -> str:
+        """A digest of outside content the node reads (a file's bytes), part of
+        its cache key so that editing that file on disk re-evaluates the node;
+        "" when the node reads nothing outside the graph (or it is unreadable:
+        evaluate() then reports the problem)."""
+        return ""
+
+    # -- stored state (stateful nodes) ------------------------------------
+    def encode_state(self, outputs: dict[str, Any]) -> dict | None:
+        """The outputs as a JSON-able dict for the project file, or None when
+        this node type cannot store them (its history is then not kept)."""
+        return None
+
+    def decode_state(self, blob: dict, inputs: dict[str, Any]) -> dict[str, Any]:
+        """Outputs rebuilt from `encode_state`'s dict against the node's current
+        inputs; raise ValueError when the blob is malformed or does not fit them."""
+        raise ValueError(f"node type {self.type_name!r} cannot restore a stored state")
 
     # -- schema helpers -------------------------------------------------
     @classmethod

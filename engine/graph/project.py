@@ -5,6 +5,11 @@ while saving leaves the previous file intact.  Loading builds a new document
 and only returns it when everything checked out; a malformed, truncated or
 wrong-version file raises ProjectFileError naming the path and the reason,
 and whatever the caller had open is untouched.
+
+Version 2 adds ``node_state``: the stored results of stateful nodes (see
+`engine.graph.node_state`), so a tiling grown and repainted by hand reopens
+as it was.  A malformed entry there does not refuse the file: it is dropped
+and ``doc.load_warnings`` says which node lost its state and why.
 """
 
 from __future__ import annotations
@@ -19,12 +24,24 @@ from engine.fileio import write_atomic
 from .document import Edge, GraphDocument, NodeInstance
 from .errors import GraphError, ProjectFileError
 from .node import node_type
+from .node_state import parse_state_entry
 
 FORMAT = "mesoforge-project"
-VERSION = 1
+VERSION = 2
+
+
+def _v1_to_v2(data: dict) -> dict:
+    return {**data, "version": 2, "node_state": {}}  # version 1 stored no node results
+
 
 # Migration hook: MIGRATIONS[v] turns a version-v dict into a version-(v+1) dict.
-MIGRATIONS: dict[int, Callable[[dict], dict]] = {}
+MIGRATIONS: dict[int, Callable[[dict], dict]] = {1: _v1_to_v2}
+
+
+def _kept_state(doc: GraphDocument) -> dict[str, Any]:
+    """doc.node_state for nodes that exist and are stateful (a removed node's goes)."""
+    return {nid: entry for nid, entry in doc.node_state.items()
+            if nid in doc.nodes and node_type(doc.nodes[nid].type_name).stateful}
 
 
 def document_to_dict(doc: GraphDocument) -> dict[str, Any]:
@@ -39,6 +56,7 @@ def document_to_dict(doc: GraphDocument) -> dict[str, Any]:
             for n in doc.nodes.values()
         ],
         "edges": [{"from": [e.src, e.src_port], "to": [e.dst, e.dst_port]} for e in doc.edges],
+        "node_state": _kept_state(doc),
     }
 
 
@@ -106,7 +124,31 @@ def document_from_dict(data: Any) -> GraphDocument:
             doc._raw_connect(Edge(e["from"][0], e["from"][1], e["to"][0], e["to"][1]))
         except GraphError as exc:
             raise ValueError(f"{where}: {exc}") from None
+    doc.node_state, doc.load_warnings = _read_node_state(data.get("node_state", {}), doc)
     return doc
+
+
+def _read_node_state(states: Any, doc: GraphDocument) -> tuple[dict[str, Any], list[str]]:
+    """The well-formed entries of ``node_state`` and a warning for each one dropped."""
+    if not isinstance(states, dict):
+        return {}, [f"node_state: expected an object, got {type(states).__name__}; "
+                    f"stored node results dropped"]
+    kept, warnings = {}, []
+    for nid, entry in states.items():
+        node = doc.nodes.get(nid)
+        if node is None:
+            warnings.append(f"node_state: no node with id {nid!r}; its stored result dropped")
+            continue
+        if not node_type(node.type_name).stateful:
+            warnings.append(f"node {nid!r} ({node.type_name}) keeps no state; its stored result dropped")
+            continue
+        try:
+            parse_state_entry(entry)
+        except ValueError as exc:
+            warnings.append(f"node {nid!r} ({node.type_name}): stored result dropped: {exc}")
+            continue
+        kept[nid] = entry
+    return kept, warnings
 
 
 def load_project(path: str | os.PathLike) -> GraphDocument:

@@ -8,9 +8,10 @@ expected; the evaluator and the undo commands both go through `Param.coerce`.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 from .errors import ParamError
 
@@ -28,9 +29,15 @@ PORT_TYPES = (
     "Mesh",
     "TileSet",
     "Tiling",
+    "PhasorFields",
+    "PhasorInfill",
+    "Energy",
 )
 
-PARAM_KINDS = ("float", "int", "bool", "enum", "vec3", "str", "samples", "int_list")
+PARAM_KINDS = ("float", "int", "bool", "enum", "vec3", "str", "samples", "int_list", "json")
+
+# Longest text of a refused "json" value quoted in an error message.
+_JSON_SHOWN = 120
 
 
 def ports_compatible(source_type: str, target_type: str) -> bool:
@@ -57,6 +64,12 @@ class Port:
             raise ValueError(f"port {self.name!r}: unknown port type {self.type!r}")
 
 
+def _shown(value: Any) -> Any:
+    """A refused value as quoted in a message: long data is cut short."""
+    text = repr(value)
+    return value if len(text) <= _JSON_SHOWN else f"{text[:_JSON_SHOWN]}... ({len(text)} characters)"
+
+
 def _finite(name: str, value: Any) -> float:
     try:
         x = float(value)
@@ -73,9 +86,13 @@ class Param:
 
     kind : one of PARAM_KINDS.
         ``samples`` is a list of ``[t, value]`` pairs with t in [0, 1] (sparse
-        thickness profile); ``int_list`` a list of integers; ``vec3`` three floats.
+        thickness profile); ``int_list`` a list of integers; ``vec3`` three floats;
+        ``json`` any JSON data (objects, lists, strings, finite numbers, true /
+        false, null), e.g. a list of brush strokes.
     minimum, maximum : inclusive range for float / int / vec3 components and
         for the values of ``samples``.
+    check : for ``json``: callable(data) -> canonical data, raising ValueError
+        (whose message says what was expected) when the data is refused.
     """
 
     name: str
@@ -87,10 +104,13 @@ class Param:
     choices: tuple = ()
     doc: str = ""
     label: str = field(default="")
+    check: Callable[[Any], Any] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         if self.kind not in PARAM_KINDS:
             raise ValueError(f"parameter {self.name!r}: unknown kind {self.kind!r}")
+        if self.check is not None and self.kind != "json":
+            raise ValueError(f"parameter {self.name!r}: only 'json' parameters take a check")
 
     # -- validation -----------------------------------------------------
     def _check_range(self, value: float, shown: Any = None) -> None:
@@ -156,7 +176,24 @@ class Param:
                 out.append([t, v])
             out.sort(key=lambda p: p[0])
             return out
+        if k == "json":
+            return self._coerce_json(value)
         raise AssertionError(k)
+
+    def _coerce_json(self, value: Any) -> Any:
+        try:
+            # a round trip gives plain lists / dicts (no tuples, no shared objects)
+            text = json.dumps(value, allow_nan=False, sort_keys=True)
+        except (TypeError, ValueError):
+            raise ParamError(self.name, _shown(value), "JSON data (objects, lists, strings, "
+                             "finite numbers, true, false, null)") from None
+        data = json.loads(text)
+        if self.check is None:
+            return data
+        try:
+            return self.check(data)
+        except ValueError as exc:
+            raise ParamError(self.name, _shown(value), str(exc)) from None
 
     def to_dict(self) -> dict:
         """Describe the parameter for UIs and documentation."""

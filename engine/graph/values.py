@@ -17,6 +17,12 @@ def _frozen(a, dtype=np.float64) -> np.ndarray:
     return arr
 
 
+def _read_only(a, dtype) -> np.ndarray:
+    """Like `_frozen`, but an array that is already read-only is kept, not copied."""
+    arr = np.asarray(a, dtype=dtype)
+    return arr if not arr.flags.writeable else _frozen(arr, dtype)
+
+
 @dataclass(frozen=True)
 class Point:
     """A vertex position, unit-cell coordinates."""
@@ -216,10 +222,35 @@ class TilingValue:
     tiling : engine.growth.Tiling (tile indices read-only); tileset :
     engine.growth.TileSet. Both are immutable; downstream nodes render or
     homogenize the tiling without knowing where the set was loaded from.
+
+    How this evaluation made it, for replaying the growth (both None when the
+    tiling was restored from a project file or loaded):
+
+    steps : (n_events, 2) int32, read-only, or None
+        ``[flat cell index, tile]`` in the order cells were decided; the flat
+        index is row-major over ``tiling.tiles`` and tile -1 marks a defect
+        forming (``Tiling.steps``).
+    start_tiles : int32 array of the grid shape, read-only, or None
+        The grid before this growth's first step: all UNASSIGNED (-2) for a
+        fresh growth; for a local regrowth the previous tiling with the
+        regrown cells (painted region plus margin) set to UNASSIGNED.
+        Writing each step's tile into a copy of it gives ``tiling.tiles``.
     """
 
     tiling: object
     tileset: object
+    steps: np.ndarray | None = None
+    start_tiles: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.steps is not None:
+            object.__setattr__(self, "steps", _read_only(self.steps, np.int32).reshape(-1, 2))
+        if self.start_tiles is not None:
+            start = _read_only(self.start_tiles, np.int32)
+            if start.shape != self.tiling.tiles.shape:
+                raise ValueError(f"TilingValue: start_tiles has shape {start.shape}, the tiling "
+                                 f"{self.tiling.tiles.shape}")
+            object.__setattr__(self, "start_tiles", start)
 
     @property
     def ndim(self) -> int:
@@ -266,3 +297,76 @@ class Field:
     def spacing(self) -> np.ndarray:
         """(ndim,) cell size in ``(x, y[, z])`` order."""
         return (self.hi - self.lo) / np.array(self.grid_shape[::-1], dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class MeshValue:
+    """A closed triangle mesh read from a file (port type "Mesh"), in mm.
+
+    vertices : (v, 3) float64, read-only
+    faces : (f, 3) int64, read-only, outward (counter-clockwise) winding
+    path : str, the file it was read from ("" when made in memory)
+
+    Has ``vertices`` and ``faces`` like a trimesh, so the kernels of
+    engine.phasor.domain take it as it is.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    path: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "vertices", _read_only(self.vertices, np.float64).reshape(-1, 3))
+        object.__setattr__(self, "faces", _read_only(self.faces, np.int64).reshape(-1, 3))
+
+    @property
+    def bounds(self) -> tuple:
+        """(lo, hi) (3,) float64 mm, the bounding box."""
+        return self.vertices.min(axis=0), self.vertices.max(axis=0)
+
+
+@dataclass(frozen=True, eq=False)
+class PhasorFieldsValue:
+    """Painted control fields of phasor infill (port type "PhasorFields").
+
+    fields : engine.phasor.PhasorFields, D, F, Gamma on an (nz, ny, nx) grid
+        over the box ``fields.lo .. fields.hi`` (mm).
+    domain : MeshValue or None, the part to fill (None: the whole box).
+    changed : (slice, slice, slice) or None
+        ``[z, y, x]`` cells that differ from this node's previous result
+        (all three ``slice(0, 0)`` when none do); None when there is no
+        previous result to compare with (everything is new).
+    n_strokes : int, brush strokes painted over the initial fields.
+    """
+
+    fields: object
+    domain: MeshValue | None = None
+    changed: tuple | None = None
+    n_strokes: int = 0
+
+
+@dataclass(frozen=True)
+class SliceEnergy:
+    """Singularity energy of one slice (port type "Energy"; Tricard et al. eq. 10).
+
+    value : float, F_S(q), the fraction of the slice's part pixels where the
+        singularity measure S(x) of p_v or of p_w exceeds q (NaN when no
+        pixel of the slice lies inside the part).
+    v, w : float, F_S(q) of p_v alone and of p_w alone.
+    q : float, the threshold.
+    pixels : int, pixels counted (|Omega|: inside the part, off the slice border).
+    state : str, which noise was measured ("raw", "aligned", "aligned+filtered").
+    engine : str, the evaluator of the slice ("gpu" or "numpy").
+    """
+
+    value: float
+    v: float
+    w: float
+    q: float
+    pixels: int
+    state: str
+    engine: str = ""
+
+    def summary(self) -> dict:
+        return {"F_S": self.value, "F_S_v": self.v, "F_S_w": self.w, "q": self.q,
+                "pixels": self.pixels, "state": self.state, "engine": self.engine}

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tiling import DEFECT, Tiling
+from .tiling import DEFECT, UNASSIGNED, Tiling
 from .wfc import grow_tiling
 
-__all__ = ["regrow_region", "dilate"]
+__all__ = ["regrow_region", "regrowth_start", "dilate"]
 
 
 def dilate(mask: np.ndarray, margin: int, *, periodic: bool) -> np.ndarray:
@@ -66,23 +66,50 @@ def regrow_region(tiling: Tiling, tileset, region_mask, *, margin: int = 1, hint
     Tiling
         Same shape; ``stats["n_cleared"]`` counts the cleared cells.
     """
-    if not isinstance(tiling, Tiling):
-        raise ValueError(f"tiling must be a Tiling; got {type(tiling).__name__}")
+    cleared = _cleared(tiling, region_mask, margin)
     if tiling.tileset_name != tileset.name:
         raise ValueError(f"tiling was grown from tile set {tiling.tileset_name!r}, "
                          f"not {tileset.name!r}")
+    start = np.where(cleared, UNASSIGNED, tiling.tiles)
+    # held tiles and defects stay; cleared cells and cells growth never reached grow
+    fixed = np.where(start >= 0, start, -1).astype(np.int64)
+    out = grow_tiling(tileset, tiling.shape, hints=hints, periodic=tiling.periodic,
+                      fixed=fixed, fixed_defects=start == DEFECT, rng=rng,
+                      record_steps=record_steps, progress=progress)
+    out.stats["n_cleared"] = int(cleared.sum())
+    return out
+
+
+def regrowth_start(tiling: Tiling, region_mask, *, margin: int = 1) -> np.ndarray:
+    """The grid `regrow_region` starts from: ``tiling.tiles`` with the region
+    and its margin set to UNASSIGNED.
+
+    Parameters
+    ----------
+    tiling : Tiling
+    region_mask : bool array of ``tiling.shape``
+    margin : int >= 0, as for `regrow_region`
+
+    Returns
+    -------
+    int32 array of ``tiling.shape``
+        Tiles and defects outside the cleared area as in ``tiling``; -2
+        (UNASSIGNED) on the cleared cells. Writing the regrown tiling's
+        ``steps`` (``tiles.flat[cell] = tile``) into a copy of it gives the
+        regrown tiles.
+    """
+    cleared = _cleared(tiling, region_mask, margin)
+    return np.where(cleared, UNASSIGNED, tiling.tiles).astype(np.int32)
+
+
+def _cleared(tiling, region_mask, margin) -> np.ndarray:
+    """Bool mask of the cells a regrowth clears: the region dilated by margin."""
+    if not isinstance(tiling, Tiling):
+        raise ValueError(f"tiling must be a Tiling; got {type(tiling).__name__}")
     region = np.asarray(region_mask)
     if region.shape != tiling.shape or region.dtype != bool:
         raise ValueError(f"region_mask must be a bool array of shape {tiling.shape}; "
                          f"got {region.dtype} {region.shape}")
     if isinstance(margin, bool) or not isinstance(margin, (int, np.integer)) or margin < 0:
         raise ValueError(f"margin must be an integer >= 0; got {margin!r}")
-    cleared = dilate(region, int(margin), periodic=tiling.periodic)
-    # cells growth never reached (UNASSIGNED) are grown too
-    fixed = np.where(cleared | (tiling.tiles < 0), -1, tiling.tiles).astype(np.int64)
-    held_defects = ~cleared & (tiling.tiles == DEFECT)
-    out = grow_tiling(tileset, tiling.shape, hints=hints, periodic=tiling.periodic,
-                      fixed=fixed, fixed_defects=held_defects, rng=rng,
-                      record_steps=record_steps, progress=progress)
-    out.stats["n_cleared"] = int(cleared.sum())
-    return out
+    return dilate(region, int(margin), periodic=tiling.periodic)

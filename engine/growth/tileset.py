@@ -14,6 +14,7 @@ side when the connector labels on the facing faces are equal; the file's
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -399,11 +400,11 @@ def load_tileset(path_or_name: str | os.PathLike) -> TileSet:
             raise ValueError(f"tile set {str(path_or_name)!r} is neither a file nor a known set "
                              f"name; known: {sorted(known)}")
         p = known[str(path_or_name)]
-    st = p.stat()
-    key = (str(p.resolve()), st.st_mtime_ns, st.st_size)
+    raw = p.read_bytes()
+    key = (str(p.resolve()), hashlib.sha256(raw).hexdigest())
     if key not in _CACHE:
         try:
-            data = json.loads(p.read_text(encoding="utf-8"))
+            data = json.loads(raw.decode("utf-8"))
         except ValueError as e:
             raise ValueError(f"tile set file {str(p)!r} is not valid JSON: {e}") from None
         _CACHE[key] = parse_tileset(data, source=str(p))

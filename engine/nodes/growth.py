@@ -10,18 +10,22 @@ import math
 import numpy as np
 
 from engine.batch.hints_text import parse_hints
+from engine.fileio import file_digest
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.graph.values import Field, LineElement, Skeleton, TilingValue
 from engine.growth import grow_tiling, list_tilesets, load_tileset, tiling_beams, tiling_image
 from engine.growth.regions import parse_region_hints, parse_region_map, region_hint_field
-from engine.growth.regrow import regrow_region
+from engine.growth.regrow import regrow_region, regrowth_start
+from engine.growth.tiling import UNASSIGNED
+from engine.growth.tiling_io import tiling_from_dict, tiling_to_dict
 from engine.growth.properties import VOID_MODES, homogenize_tiling
 
 from .properties import stiffness_from_result
 
 MAX_CELLS = 1_000_000
+REGROW_MARGIN = 1  # cells cleared around a repainted region (square neighbourhood)
 
 
 def _tileset_names() -> tuple:
@@ -56,6 +60,14 @@ class TileSetNode(NodeType):
         Param("path", "str", "", doc="a tile-set JSON file; overrides name when not empty"),
     )
 
+    @classmethod
+    def source_token(cls, params):
+        # the set is read from a file the user may edit (Tile Sets dock): its bytes key the cache
+        path = params.get("path", "").strip()
+        if not path:
+            path = list_tilesets().get(params.get("name", ""), "")
+        return file_digest(path) if path else ""
+
     def evaluate(self, inputs, params, ctx):
         source = params["path"].strip() or params["name"]
         try:
@@ -82,7 +94,9 @@ def grid_shape(size, tileset) -> tuple:
 class GrowNode(NodeType):
     """Virtual growth: fills a grid with tiles of the set by minimal-entropy
     wave-function collapse under the adjacency rules and frequency hints.
-    The seed comes from the document seed and the node id."""
+    The seed comes from the document seed and the node id. Repainting the
+    hint regions regrows only the repainted cells; the tiling (with that
+    history) is kept in the project file."""
 
     type_name = "Grow"
     title = "Grow"
@@ -120,16 +134,36 @@ class GrowNode(NodeType):
         availability = params["availability"] or None
         previous = ctx.previous.get("tiling") if ctx.previous else None
         changed = self._changed_cells(previous, ts, shape, params, labels, field, ctx)
+        if changed is not None and not changed.any():
+            # the same painted cells (a region text that parses alike, or a result
+            # restored from a file under an older cache key): the tiling stays
+            tiling = previous.tiling
+            return {"tiling": TilingValue(tiling, ts, np.zeros((0, 2), np.int32), tiling.tiles)}
         if changed is not None:
             # Local regrowth (paper's repainting): only repainted cells plus a margin
             # grow again; every other tile stays byte-identical.
-            tiling = regrow_region(previous.tiling, ts, changed, margin=1,
+            start = regrowth_start(previous.tiling, changed, margin=REGROW_MARGIN)
+            tiling = regrow_region(previous.tiling, ts, changed, margin=REGROW_MARGIN,
                                    hints=field if field is not None else hints, rng=ctx.seed,
-                                   progress=ctx.progress)
+                                   record_steps=True, progress=ctx.progress)
         else:
+            start = np.full(shape, UNASSIGNED, np.int32)
             tiling = grow_tiling(ts, shape, hints=field if field is not None else hints,
                                  periodic=params["periodic"], availability=availability, rng=ctx.seed,
-                                 progress=ctx.progress)
+                                 record_steps=True, progress=ctx.progress)
+        return {"tiling": TilingValue(tiling, ts, tiling.steps, start)}
+
+    def encode_state(self, outputs):
+        tv = outputs["tiling"]
+        return {"tiling": tiling_to_dict(tv.tiling, tv.tileset)}
+
+    def decode_state(self, blob, inputs):
+        ts = inputs["tileset"]
+        if ts is None:
+            raise ValueError("no tile set is connected")
+        if not isinstance(blob, dict) or not isinstance(blob.get("tiling"), dict):
+            raise ValueError("expected {'tiling': <tiling document>}")
+        tiling = tiling_from_dict(blob["tiling"], ts, source="stored tiling")
         return {"tiling": TilingValue(tiling, ts)}
 
     @staticmethod
@@ -148,8 +182,9 @@ class GrowNode(NodeType):
 
     @staticmethod
     def _changed_cells(previous, ts, shape, params, labels, field, ctx):
-        """Cells to regrow when only the painted regions changed since the last
-        evaluation of this node (same set, size, seed, periodicity); else None."""
+        """Bool mask of the cells to regrow when at most the painted regions
+        changed since the last evaluation of this node (same set, size, seed,
+        periodicity; all False when nothing did); else None (grow afresh)."""
         prev_params = ctx.previous_params or {}
         same = (previous is not None and previous.tileset is ts and previous.tiling.tiles.shape == tuple(shape)
                 and not params["availability"]
@@ -167,7 +202,7 @@ class GrowNode(NodeType):
             changed = (old != new) | (new != 0) | (old != 0)
         else:
             changed = old != new
-        return changed if changed.any() else None
+        return changed
 
 
 @register

@@ -164,3 +164,54 @@ def test_defects_are_marked_and_replayed(window, wait_eval):
 def qtbot_button():
     from PySide6 import QtCore
     return QtCore.Qt.MouseButton.LeftButton
+
+
+def test_painting_in_the_window_regrows_locally_and_replays(window, wait_eval, qtbot):
+    """A stroke on the dock's tiling is one undo step; the evaluation it triggers regrows
+    only the painted cells and their margin, and the replay starts from the kept tiling."""
+    from engine.growth.regions import parse_region_map
+    from engine.growth.regrow import dilate
+
+    ids, report = evaluated(window, wait_eval)
+    window.editor.select(ids["grow"])
+    panel = window.growth_panel
+    if panel.undo is None:   # until the window hands the dock its undo stack
+        panel.set_undo(window.undo)
+    assert panel.view.painting
+    old = np.array(report.outputs[ids["grow"]]["tiling"].tiling.tiles)
+    panel.region_tools.label_buttons[3].click()
+    panel.region_tools.radius.setValue(0.0)
+    view = panel.view
+    n = window.eval_count
+    points = [view.widget_point(x, 1.5).toPoint() for x in (1.5, 2.5, 3.5)]
+    qtbot.mousePress(view, qtbot_button(), pos=points[0])
+    for p in points[1:]:
+        qtbot.mouseMove(view, p)
+    qtbot.mouseRelease(view, qtbot_button(), pos=points[-1])
+    params = window.doc.nodes[ids["grow"]].params
+    labels = parse_region_map(params["regions"], old.shape)
+    expected = np.zeros(old.shape, int)
+    expected[1, 1:4] = 3
+    np.testing.assert_array_equal(labels, expected)
+    assert window.undo.undo_text() == f"set {ids['grow']}.regions"
+
+    report = wait_eval(window, n)
+    assert not report.errors, report.errors
+    tv = report.outputs[ids["grow"]]["tiling"]
+    tiles = np.asarray(tv.tiling.tiles)
+    kept = ~dilate(labels > 0, 1, periodic=True)
+    np.testing.assert_array_equal(tiles[kept], old[kept])
+    assert panel.value is tv
+    panel.restart()
+    np.testing.assert_array_equal(panel.shown_tiles[kept], old[kept])
+    assert panel.assigned_count() == int(kept.sum())
+    assert "local regrowth" in panel.anim_label.text()
+    while panel.anim_pos < panel.n_steps:
+        panel.step(2)
+    np.testing.assert_array_equal(panel.shown_tiles, tiles)
+
+    n = window.eval_count
+    assert window.undo.undo()
+    assert window.doc.nodes[ids["grow"]].params["regions"] == ""
+    assert view.labels is None
+    wait_eval(window, n)

@@ -5,10 +5,12 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from app.autosave import AutosaveManager
-from engine.graph import AddNode, SetSeed, document_to_dict
+from engine.graph import AddNode, Connect, SetParam, SetSeed, document_to_dict, load_project
+from engine.growth.regions import format_region_map
 from ui.main_window import EXAMPLES_DIR
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
@@ -111,3 +113,38 @@ def test_autosave_timer_writes_only_unsaved_work(make_window, qtbot, tmp_path):
     qtbot.waitUntil(window.autosave.autosave_path.exists, timeout=2000)
     window.save_as(tmp_path / "p.json")                   # a clean save removes the autosave
     assert not window.autosave.autosave_path.exists()
+
+
+def test_repainted_tiling_survives_save_and_reopen(make_window, wait_eval, tmp_path, prompter):
+    window = make_window()
+    window.undo.push(AddNode("TileSet", {}, (0, 0), node_id="ts"))
+    window.undo.push(AddNode("Grow", {"size": [12, 12]}, (240, 0), node_id="g"))
+    window.undo.push(Connect("ts", "tileset", "g", "tileset"))
+    first = wait_eval(window, window.eval_count)
+    assert first.ok, first.errors
+    grown = np.array(first.output("g").tiling.tiles)
+    labels = np.zeros((12, 12), int)
+    labels[3:7, 2:8] = 1
+    count = window.eval_count
+    window.undo.push(SetParam("g", "region_hints", "1: +=50,T=1,L=1,-=1"))
+    window.undo.push(SetParam("g", "regions", format_region_map(labels)))
+    report = wait_eval(window, count)
+    assert report.ok, report.errors
+    regrown = np.array(report.output("g").tiling.tiles)
+    assert not np.array_equal(regrown, grown)
+    assert window.autosave_now()                              # the autosave keeps the history too
+    assert set(load_project(window.autosave.autosave_path).node_state) == {"g"}
+    project = tmp_path / "grown.json"
+    assert window.save_as(project)
+
+    other = make_window(project)
+    reopened = wait_eval(other, 0)
+    assert reopened.ok, reopened.errors
+    assert reopened.results["g"].status == "cached"          # restored from the file
+    assert np.array(reopened.output("g").tiling.tiles).tobytes() == regrown.tobytes()
+    # the first window, reopening the file over its own session, gets the same tiles
+    count = window.eval_count
+    assert window.open_project(project, ask=False)
+    again = wait_eval(window, count)
+    assert np.array(again.output("g").tiling.tiles).tobytes() == regrown.tobytes()
+    assert not prompter.errors

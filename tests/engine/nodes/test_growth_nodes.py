@@ -144,3 +144,29 @@ def test_tiling_properties_3d_and_bad_shape():
     st.push(SetParam("g", "size", [2, 2, 3]))
     r = Evaluator().evaluate(doc)
     assert r.results["p"].status == "failed" and "cubic tiling" in r.errors["p"]
+
+
+def test_editing_a_tileset_file_on_disk_re_evaluates_the_nodes(tmp_path):
+    import json
+    import os
+
+    from engine.growth import list_tilesets
+
+    data = json.loads(list_tilesets()["TL+-"].read_text(encoding="utf-8"))
+    data["name"] = "edited-on-disk"
+    path = tmp_path / "set.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    doc, st = _grow_graph(size=(6, 5))
+    st.push(SetParam("ts", "path", str(path)))
+    ev = Evaluator()
+    r1, _ = _tiles(doc, ev)
+    assert _tiles(doc, ev)[0].results["g"].status == "cached"
+    before = r1.output("ts").weights.copy()
+    blocks = data["blocks"]
+    first = blocks[0] if isinstance(blocks, list) else next(iter(blocks.values()))
+    first["weight"] = 7.0
+    path.write_text(json.dumps(data), encoding="utf-8")
+    os.utime(path, ns=(1, 1))        # a changed file with an old time stamp still counts
+    r2, _ = _tiles(doc, ev)
+    assert r2.results["ts"].status == "evaluated" and r2.results["g"].status == "evaluated"
+    assert not np.array_equal(before, r2.output("ts").weights)
