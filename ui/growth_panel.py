@@ -259,9 +259,12 @@ class GrowthPanel(QtWidgets.QWidget):
             self._watched.unsubscribe(self._on_doc_event)
         self._watched = doc
         if doc is not None:
-            callback = self._on_doc_event
-            doc.subscribe(callback)
-            self.destroyed.connect(lambda *_: doc.unsubscribe(callback))
+            doc.subscribe(self._on_doc_event)
+
+    def detach(self) -> None:
+        """Stop following the document and stop the replay (the window is closing)."""
+        self.pause()
+        self._watch(None)
 
     def _on_doc_event(self, event: str, payload) -> None:
         try:

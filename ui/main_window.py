@@ -24,6 +24,7 @@ from engine.graph.values import Solid
 from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
 from .growth_panel import GrowthPanel
+from .study_panel import StudyPanel
 from .tileset_editor import TileSetEditor
 from .inspector import Inspector
 from .node_editor import NodeEditor
@@ -112,6 +113,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tileset_dock = self._dock("Tile Sets", self.tileset_editor, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.tileset_dock)
         self.tileset_editor.message.connect(self.log)
+        self.study_panel = StudyPanel(self)
+        self.study_dock = self._dock("Studies", self.study_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.study_dock)
+        self.study_panel.study_finished.connect(
+            lambda code: self.log("info" if code == 0 else "warning", f"study finished with exit code {code}"))
         self.inspector_dock.raise_()
 
         bottom = QtWidgets.QWidget()
@@ -622,10 +628,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self._shutting_down = True
         self._debounce.stop()
         self._autosave_timer.stop()
-        self.growth_panel.pause()
+        self.growth_panel.detach()
         self.worker.shutdown()
         self.editor.detach()
         self.inspector.detach()
+        self.tileset_editor.detach()
+        self.study_panel.shutdown()
         self.doc.unsubscribe(self._on_doc_event)
         self.autosave.clear()
         self.viewport.close_plotter()

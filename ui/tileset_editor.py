@@ -57,7 +57,6 @@ class TileSetEditor(QtWidgets.QWidget):
         self.ask_text: Callable[[str, str, str], str | None] = self._text_dialog
         self._build()
         doc.subscribe(self._on_doc_event)
-        self.destroyed.connect(lambda *_, cb=self._on_doc_event: doc.unsubscribe(cb))
         self.refresh_browser()
         self._refresh()
 
@@ -176,6 +175,10 @@ class TileSetEditor(QtWidgets.QWidget):
         return w
 
     # -- dialogs (replaceable) ------------------------------------------------------------------
+    def detach(self) -> None:
+        """Stop following the document (the window is closing)."""
+        self.doc.unsubscribe(self._on_doc_event)
+
     def _confirm_dialog(self, title: str, text: str) -> bool:
         yes = QtWidgets.QMessageBox.StandardButton.Yes
         return QtWidgets.QMessageBox.question(self, title, text) == yes
