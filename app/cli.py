@@ -7,6 +7,7 @@
     mesoforge homogenize INPUT [--E 1 --nu 0.45] [--res N] [--json]
     mesoforge grow TILESET --size 20x20 --out tiling.json [--png t.png] [--hints T=1,+=2] [--json]
     mesoforge study TILESET [--hints ...] [--n 100] [--out study.csv] [--scheduler ADDR] [--json]
+    mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--node ID]
 """
 
 from __future__ import annotations
@@ -168,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     homogenize_cmd.add_parser(sub)
     from app import growth_cmd
     growth_cmd.add_parsers(sub)
+    from app import phasor_cmd
+    phasor_cmd.add_parsers(sub)
     return p
 
 
@@ -188,6 +191,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command in ("grow", "study"):
         from app import growth_cmd
         return growth_cmd.run(args)
+    if args.command == "phasor":
+        from app import phasor_cmd
+        return phasor_cmd.run(args)
     build_parser().print_help()
     return 2
 

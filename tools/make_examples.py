@@ -21,7 +21,7 @@ lines, transforms ..., objects, CSG, voxel) so the editor shows a tidy graph.
 Usage::
 
     python tools/make_examples.py                  # all examples
-    python tools/make_examples.py --only octet bcc # a subset
+    python tools/make_examples.py --only octet bcc # a subset (phasor_slab: the phasor infill example)
     python tools/make_examples.py --out /tmp/ex    # somewhere else
 
 The test ``tests/resources/test_examples.py`` regenerates the files and
@@ -559,6 +559,74 @@ EXAMPLES: dict[str, Callable[[], GraphBuilder]] = {
 }
 
 
+# =============================================================== phasor infill examples
+#
+# Not unit cells: a part's box filled with phasor-noise diamond cells (Tricard
+# et al. 2020), seeded from a field spec and painted with brush strokes, each
+# stroke one SetParam of the whole stroke list as the window's paint canvas does.
+
+def phasor_slab() -> GraphDocument:
+    import json
+    import math
+
+    from engine.graph import SetParam
+    from engine.phasor.strokes import Stroke
+
+    doc = GraphDocument(seed=0)
+    doc.meta = {"example": "phasor_slab", "title": "Phasor infill: painted slab",
+                "source": "Tricard et al. 2020 (phasor infill)", "paper_node_count": None,
+                "description": "A 30 x 30 x 6 mm slab of diamond cells. D starts vertical (cells "
+                               "lined up with x and y in every layer) and F falls from 1 cell/mm at "
+                               "the centre to 0.7 at 15 mm. Brush strokes then tilt D along a curved "
+                               "drag (the cells turn to follow it), tilt it diagonally in a corner, "
+                               "raise F along the bottom edge and add angular spread on the right. "
+                               "The slice shows the layer at mid height."}
+    spec = {"D": [0.0, 0.0, 1.0],
+            "F": {"kind": "radial", "axis": "z", "centre": [0.0, 0.0, 0.0], "from": 1.0, "to": 0.7,
+                  "radius": 15.0},
+            "Gamma": 0.0}
+    stack = UndoStack(doc)
+    stack.push(AddNode("PhasorFields", {"lo": [-15.0, -15.0, 0.0], "hi": [15.0, 15.0, 6.0],
+                                        "resolution": 64, "spec": json.dumps(spec)},
+                       (0.0, 0.0), node_id="fields"))
+    stack.push(AddNode("PhasorNoise", {}, (COLUMN_WIDTH, 0.0), node_id="noise"))
+    stack.push(AddNode("PhasorSlice", {"position": 3.0, "pixel": 0.1}, (2 * COLUMN_WIDTH, 0.0),
+                       node_id="slice"))
+    stack.push(Connect("fields", "fields", "noise", "fields"))
+    stack.push(Connect("noise", "infill", "slice", "infill"))
+    arc = [[_r(8.0 * math.cos(math.radians(a))), _r(8.0 * math.sin(math.radians(a)))]
+           for a in range(200, 341, 20)]
+    tilt = 1.1  # radians out of the slice plane: D leans 27 degrees from vertical
+    strokes = [
+        Stroke("D", "z", 3.0, arc, 4.0, tilt=tilt, depth=4.0),
+        Stroke("D", "z", 3.0, [[-9.0, 9.0], [-6.0, 6.0]], 5.0, heading=[1.0, 1.0], tilt=tilt, depth=4.0),
+        Stroke("F", "z", 3.0, [[-12.0, -13.0], [12.0, -13.0]], 2.5, value=1.2, depth=4.0),
+        Stroke("Gamma", "z", 3.0, [[11.0, 2.0], [11.0, 10.0]], 3.0, value=0.3, falloff="linear", depth=4.0),
+    ]
+    for stroke in strokes:  # one SetParam per stroke, as the paint canvas pushes them
+        painted = doc.node("fields").params["strokes"]
+        stack.push(SetParam("fields", "strokes", painted + [stroke.to_dict()]))
+    return doc
+
+
+PHASOR_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
+    "phasor_slab": phasor_slab,
+}
+
+
+def write_phasor_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
+    """Build the phasor infill examples (all, or `names`) as ``<out_dir>/<name>.json``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = {}
+    for name in names or PHASOR_EXAMPLES:
+        doc = PHASOR_EXAMPLES[name]()
+        path = out / f"{name}.json"
+        save_project(doc, path)
+        written[path] = doc
+    return written
+
+
 def build(name: str) -> GraphDocument:
     """The example `name` as a fresh GraphDocument."""
     return EXAMPLES[name]().document()
@@ -580,9 +648,14 @@ def write_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path,
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=str(EXAMPLES_DIR), help="output folder (default: resources/examples)")
-    parser.add_argument("--only", nargs="+", choices=sorted(EXAMPLES), help="build only these examples")
+    parser.add_argument("--only", nargs="+", choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES),
+                        help="build only these examples")
     args = parser.parse_args(argv)
-    for path, doc in write_examples(args.out, args.only).items():
+    cells = [n for n in args.only or EXAMPLES if n in EXAMPLES]
+    phasor = [n for n in args.only or PHASOR_EXAMPLES if n in PHASOR_EXAMPLES]
+    written = {**(write_examples(args.out, cells) if cells else {}),
+               **(write_phasor_examples(args.out, phasor) if phasor else {})}
+    for path, doc in written.items():
         paper = doc.meta["paper_node_count"]
         print(f"{path}  ({len(doc.nodes)} nodes; paper: {paper if paper is not None else '-'})")
     return 0

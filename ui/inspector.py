@@ -11,6 +11,8 @@ under the parameters.
 
 from __future__ import annotations
 
+import json
+
 import math
 import time
 from typing import Any, Callable
@@ -295,9 +297,33 @@ class SamplesEditor(ParamEditor):
         self._blocked([self.table], apply)
 
 
+class JsonEditor(ParamEditor):
+    """Structured data made by gestures elsewhere (e.g. brush strokes): shown as a
+    summary; a list can be cleared in one undoable step."""
+
+    def _build(self):
+        w = QtWidgets.QWidget()
+        row = QtWidgets.QHBoxLayout(w)
+        row.setContentsMargins(0, 0, 0, 0)
+        self.label = QtWidgets.QLabel()
+        self.clear_button = QtWidgets.QPushButton("Clear")
+        self.clear_button.clicked.connect(lambda: self.edited.emit([]))
+        row.addWidget(self.label, 1)
+        row.addWidget(self.clear_button)
+        return w
+
+    def set_value(self, value):
+        if isinstance(value, list):
+            self.label.setText(f"{len(value)} item{'s' if len(value) != 1 else ''}")
+        else:
+            text = json.dumps(value)
+            self.label.setText(text if len(text) <= 60 else text[:57] + "...")
+        self.clear_button.setEnabled(isinstance(value, list) and bool(value))
+
+
 EDITORS = {
     "float": FloatEditor, "int": IntEditor, "bool": BoolEditor, "enum": EnumEditor, "str": StrEditor,
-    "vec3": Vec3Editor, "int_list": IntListEditor, "samples": SamplesEditor,
+    "vec3": Vec3Editor, "int_list": IntListEditor, "samples": SamplesEditor, "json": JsonEditor,
 }
 
 STATUS_COLOURS = {"evaluated": "#5cb85c", "cached": "#5bc0de", "failed": "#e04040",

@@ -24,6 +24,7 @@ from engine.graph.values import Solid
 from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
 from .growth_panel import GrowthPanel
+from .phasor_panel import PhasorPanel
 from .study_panel import StudyPanel
 from .tileset_editor import TileSetEditor
 from .inspector import Inspector
@@ -113,6 +114,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tileset_dock = self._dock("Tile Sets", self.tileset_editor, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.tileset_dock)
         self.tileset_editor.message.connect(self.log)
+        self.phasor_panel = PhasorPanel(self.doc, self.undo, self)
+        self.phasor_dock = self._dock("Phasor Infill", self.phasor_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.phasor_dock)
+        self.phasor_panel.preview_lines.connect(self.viewport.show_toolpaths)
         self.study_panel = StudyPanel(self)
         self.study_dock = self._dock("Studies", self.study_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.study_dock)
@@ -412,6 +417,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.shown_solid_id, self.shown_skeleton_id = solid_id, skel_id
         self.shown_stiffness_id = stiffness_id
         self.growth_panel.set_context(self.doc, outputs, sel)
+        self.phasor_panel.set_context(self.doc, outputs, sel)
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
                                   skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
                                   sphere_caption=sphere_caption)
@@ -629,6 +635,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._debounce.stop()
         self._autosave_timer.stop()
         self.growth_panel.detach()
+        self.phasor_panel.shutdown()
         self.worker.shutdown()
         self.editor.detach()
         self.inspector.detach()

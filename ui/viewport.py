@@ -16,6 +16,7 @@ import pyvista as pv
 from pyvistaqt import QtInteractor
 from PySide6 import QtWidgets
 
+from engine.fab import vtk_line_cells
 from engine.graph import GraphDocument
 from engine.graph.values import Skeleton, Solid, Stiffness, VoxelModel
 from engine.physics.material_sphere import material_polar, material_sphere_polydata
@@ -206,6 +207,7 @@ class Viewport(QtWidgets.QWidget):
         self._shown_points = 0
         self._camera_key = None
         self._closed = False
+        self.toolpaths: pv.PolyData | None = None
         self.redraw()
 
     # -- state --------------------------------------------------------------------
@@ -236,6 +238,26 @@ class Viewport(QtWidgets.QWidget):
     def set_show_sphere(self, on: bool) -> None:
         self.show_sphere = bool(on)
         self.redraw()
+
+    def show_toolpaths(self, points, segments, colours) -> None:
+        """Print preview: line segments (m, 2) between `points` (n, 3) mm, each
+        coloured by `colours` (m, 3) uint8 (perimeter, infill, travel...)."""
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        segments = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
+        if not len(segments):
+            self.clear_toolpaths()
+            return
+        lines = pv.PolyData(points, lines=vtk_line_cells(segments))
+        lines.cell_data["rgb"] = np.asarray(colours, dtype=np.uint8).reshape(-1, 3)
+        self.toolpaths = lines
+        self.redraw()
+
+    def clear_toolpaths(self) -> None:
+        self.toolpaths = None
+        self.redraw()
+
+    def toolpath_segment_count(self) -> int:
+        return 0 if self.toolpaths is None else int(self.toolpaths.n_cells)
 
     def sphere_point_count(self) -> int:
         """Number of material-sphere points currently shown (0 when none is)."""
@@ -283,14 +305,17 @@ class Viewport(QtWidgets.QWidget):
         self._draw_cell_boxes(c)
         if self.show_sphere and self.stiffness is not None:
             self._draw_material_sphere(self.stiffness, c)
+        if self.toolpaths is not None:
+            p.add_mesh(self.toolpaths, scalars="rgb", rgb=True, line_width=1.5, name="toolpaths")
         sphere_line = self.sphere_caption if self._sphere_points else self._sphere_note
         caption = "\n".join(t for t in (self.caption, sphere_line) if t)
         if caption:
             p.add_text(caption, position="upper_left", font_size=9, color="white", name="caption")
-        if self.solid is None and self.skeleton is None:
+        if self.solid is None and self.skeleton is None and self.toolpaths is None:
             p.add_text("nothing to show yet: evaluate a graph with a solid or skeleton node",
                        position="lower_left", font_size=9, color="#9aa0a6", name="hint")
-        key = (self.tiles, round(c, 9), self._sphere_points > 0)
+        key = (self.tiles, round(c, 9), self._sphere_points > 0,
+               None if self.toolpaths is None else tuple(np.round(self.toolpaths.bounds, 3)))
         if key != self._camera_key:
             self._camera_key = key
             self._home_camera()

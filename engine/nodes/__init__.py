@@ -1,3 +1,3 @@
 """Node types.  Importing this package registers them all."""
 
-from . import growth, lines, properties, solids, topology, transforms  # noqa: F401
+from . import growth, lines, phasor, properties, solids, topology, transforms  # noqa: F401

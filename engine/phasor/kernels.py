@@ -10,6 +10,9 @@ Two sawtooth phasor noises are built from one set of kernel sites
   sampled from F at x_j), unit direction ``d_kj`` and phase ``phi_kj``
   (radians).  ``d_vj`` is v = z x D(x_j) rotated about w(x_j) by an angle
   uniform in [-Gamma(x_j), Gamma(x_j)]; ``d_wj`` is w = (z x D) x D.
+  Both normalised; where D is vertical (|z x D| < 1e-6) v is
+  normalise(x - (x . D) D) instead, and always w = v x D
+  (:func:`engine.phasor.sampling.local_frame`; e_k below uses it too).
 
 Unfiltered complex noise at a point x (mm), truncated at |x - x_j| < R:
 
@@ -33,7 +36,8 @@ filtered Gaussian falls to exp(-pi)).  This is the Gaussian convolution of
 the local phasor field worked out in closed form (the constant factor
 (pi / (a + b))^(3/2) is the same for every kernel and dropped: only Arg
 matters).  A(x) in [0, 1] attenuates the filter where the local angular
-spread is large (section 4.2.4).
+spread is large (section 4.2.4); it is a grid on the fields' cells sampled
+trilinearly like F (:mod:`engine.phasor.attenuation`), A = 1 when none is given.
 
 The sawtooth value is ``p_k(x) = (Arg G_k(x) / 2 pi) mod 1`` and a point is
 in a black diamond cell when ``|1/2 - p_v| + |1/2 - p_w| < 1/2``.

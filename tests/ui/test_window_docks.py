@@ -19,3 +19,23 @@ def test_growth_docks_are_in_the_window_and_act_on_its_undo_stack(window):
     assert window.undo.undo_text() != pushed_before
     window.undo.undo()
     assert window.undo.undo_text() == pushed_before
+
+
+def test_phasor_example_paints_in_the_window_and_toolpaths_show_in_the_viewport(window, qtbot, wait_eval):
+    import numpy as np
+
+    from ui.main_window import EXAMPLES_DIR
+
+    after = window.eval_count
+    assert window.open_example(EXAMPLES_DIR / "phasor_slab.json", ask=False)
+    window.evaluate_now()
+    report = wait_eval(window, after, timeout=120000)
+    assert report.ok, report.errors
+    assert window.phasor_panel.fields_id is not None
+    titles = {d.windowTitle() for d in window.findChildren(QtWidgets.QDockWidget)}
+    assert "Phasor Infill" in titles
+    points = np.array([[0, 0, 0.2], [10, 0, 0.2], [10, 10, 0.2]], float)
+    segments = np.array([[0, 1], [1, 2]])
+    colours = np.array([[255, 0, 0], [0, 0, 255]], np.uint8)
+    window.phasor_panel.preview_lines.emit(points, segments, colours)
+    assert window.viewport.toolpath_segment_count() == 2

@@ -1,0 +1,377 @@
+"""Phasor infill nodes (Tricard et al. 2020): the part's mesh, the painted
+control fields, the aligned phasor noise and its slices.
+
+    MeshImport --mesh--> PhasorFields --fields--> PhasorNoise --infill--> PhasorSlice
+
+Painting is data: every brush stroke in the window is one
+``SetParam(node, "strokes", old + [stroke.to_dict()])``.  PhasorFields and
+PhasorNoise are stateful, so a stroke appended to the list repaints only its
+own cells, and the noise resamples and re-aligns only the kernels there.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import math
+import zlib
+from dataclasses import replace
+
+import numpy as np
+
+from engine.graph.errors import NodeInputError
+from engine.graph.node import NodeType, register
+from engine.graph.schema import Param, Port
+from engine.graph.values import Field, MeshValue, PhasorFieldsValue, SliceEnergy
+from engine.phasor.field_init import DEFAULT_SPEC, fields_from_spec
+from engine.phasor.strokes import Stroke, apply_stroke, stroke_weights
+
+DEFAULT_SPEC_TEXT = json.dumps(DEFAULT_SPEC)
+SHOW = ("diamonds", "p_v", "p_w", "singularity")
+SHOW_S_MAX = 10.0  # singularity images are clipped here (inf where G = 0) for display
+MAX_FIELD_CELLS = 256 ** 3
+
+
+def _canonical_strokes(data):
+    """A stroke list in canonical form (each stroke through Stroke.from_dict);
+    ValueError names the stroke and its key."""
+    if not isinstance(data, list):
+        raise ValueError(f"a list of brush strokes, got {type(data).__name__}")
+    out = []
+    for i, item in enumerate(data):
+        try:
+            out.append(Stroke.from_dict(item).to_dict())
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"a list of brush strokes; stroke {i}: {exc}") from None
+    return out
+
+
+def _same_mesh(a, b) -> bool:
+    if a is b:
+        return True
+    if a is None or b is None:
+        return False
+    return np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+
+
+def _union(a, b):
+    if a[0].stop <= a[0].start:
+        return b
+    if b[0].stop <= b[0].start:
+        return a
+    return tuple(slice(min(x.start, y.start), max(x.stop, y.stop)) for x, y in zip(a, b))
+
+
+_EMPTY = (slice(0, 0),) * 3
+
+
+def _weight_box(fields, stroke):
+    """[z, y, x] box of the cells a stroke paints (non-zero weight), as apply_stroke reports it."""
+    w = stroke_weights(fields, stroke) > 0
+    if not w.any():
+        return _EMPTY
+    box = []
+    for axis in range(3):
+        hit = np.flatnonzero(w.any(axis=tuple(a for a in range(3) if a != axis)))
+        box.append(slice(int(hit[0]), int(hit[-1]) + 1))
+    return tuple(box)
+
+
+# ------------------------------------------------------------------ MeshImport
+
+@register
+class MeshImportNode(NodeType):
+    """The part to fill: a closed triangle mesh (STL, OBJ, PLY, 3MF) in mm.
+    An open, non-manifold or inconsistently wound mesh is refused, naming
+    an edge where it fails."""
+
+    type_name = "MeshImport"
+    title = "Mesh Import"
+    code = "mesh"
+    family = "solid"
+    outputs = (Port("mesh", "Mesh"),)
+    params = (Param("path", "str", "", doc="mesh file (.stl .obj .ply .3mf), mm"),)
+
+    def evaluate(self, inputs, params, ctx):
+        from engine.phasor.domain import load_domain_mesh
+
+        path = params["path"].strip()
+        if not path:
+            raise NodeInputError("no mesh file given: set path to an .stl, .obj, .ply or .3mf file",
+                                 where="path")
+        try:
+            mesh = load_domain_mesh(path)
+        except (ValueError, OSError) as exc:
+            raise NodeInputError(str(exc), where="path") from None
+        return {"mesh": MeshValue(mesh.vertices, mesh.faces, path)}
+
+
+# ------------------------------------------------------------------ PhasorFields
+
+def grid_shape(lo, hi, resolution: int) -> tuple:
+    """(nz, ny, nx): ``resolution`` cells along the box's longest axis, the
+    others in proportion (at least 2)."""
+    ext = np.asarray(hi, float) - np.asarray(lo, float)
+    n = [max(2, int(round(resolution * e / ext.max()))) for e in ext]
+    return tuple(n[::-1])
+
+
+@register
+class PhasorFieldsNode(NodeType):
+    """Control fields of phasor infill: direction D, frequency F (cells/mm) and
+    angular spread Gamma (radians) on a grid over the part's box (or lo..hi
+    without a part), initialised from `spec` and painted by `strokes`.
+    Appending strokes repaints only the new strokes' cells."""
+
+    type_name = "PhasorFields"
+    title = "Phasor Fields"
+    code = "pf"
+    family = "topology"
+    stateful = True
+    inputs = (Port("domain", "Mesh", required=False, doc="the part; its box plus margin is the grid's box"),)
+    outputs = (Port("fields", "PhasorFields"),)
+    params = (
+        Param("lo", "vec3", [-10.0, -10.0, -10.0], unit="mm", doc="box corner without a domain"),
+        Param("hi", "vec3", [10.0, 10.0, 10.0], unit="mm", doc="opposite box corner without a domain"),
+        Param("margin", "float", 1.0, 0.0, 1000.0, unit="mm", doc="added around the domain's box"),
+        Param("resolution", "int", 64, 2, 256, unit="cells",
+              doc="cells along the box's longest axis (others in proportion, at least 2)"),
+        Param("spec", "str", DEFAULT_SPEC_TEXT,
+              doc="initial fields as JSON: {\"D\": ..., \"F\": ..., \"Gamma\": ...} "
+                  "(see engine.phasor.field_init)"),
+        Param("strokes", "json", [], check=_canonical_strokes,
+              doc="painted brush strokes, in order (Stroke.to_dict)"),
+    )
+
+    def evaluate(self, inputs, params, ctx):
+        domain = inputs.get("domain")
+        lo, hi = self._box(domain, params)
+        shape = grid_shape(lo, hi, params["resolution"])
+        strokes = [Stroke.from_dict(d) for d in params["strokes"]]
+        prev = ctx.previous.get("fields") if ctx.previous else None
+        pp = ctx.previous_params or {}
+        same_base = (prev is not None and _same_mesh(prev.domain, domain)
+                     and all(pp.get(k) == params[k] for k in ("lo", "hi", "margin", "resolution", "spec"))
+                     and prev.fields.shape == shape)
+        if same_base:
+            old = pp.get("strokes") or []
+            k = 0
+            while k < min(len(old), len(params["strokes"])) and old[k] == params["strokes"][k]:
+                k += 1
+            if k == len(old):
+                # the previous strokes are a prefix: paint only the new ones
+                fields, changed = self._paint(prev.fields, strokes[k:], 0)
+                return {"fields": PhasorFieldsValue(fields, domain, changed, len(strokes))}
+        fields = self._initial(domain, lo, hi, shape, params)
+        if same_base:
+            # from scratch, but only cells under the differing strokes differ
+            fields, changed = self._paint(fields, strokes, k)
+            for d in old[k:]:
+                changed = _union(changed, _weight_box(fields, Stroke.from_dict(d)))
+        else:
+            fields, _ = self._paint(fields, strokes, len(strokes))
+            changed = None
+        return {"fields": PhasorFieldsValue(fields, domain, changed, len(strokes))}
+
+    @staticmethod
+    def _box(domain, params):
+        if domain is not None:
+            from engine.phasor.domain import box_of
+            return box_of(domain, params["margin"])
+        lo, hi = np.array(params["lo"]), np.array(params["hi"])
+        if np.any(hi <= lo):
+            raise NodeInputError(f"hi {params['hi']} must exceed lo {params['lo']} on every axis (mm)",
+                                 where="hi")
+        return lo, hi
+
+    @staticmethod
+    def _initial(domain, lo, hi, shape, params):
+        if math.prod(shape) > MAX_FIELD_CELLS:
+            raise NodeInputError(f"a grid of {shape[::-1]} cells is more than {MAX_FIELD_CELLS}",
+                                 where="resolution")
+        try:
+            spec = json.loads(params["spec"]) if params["spec"].strip() else {}
+        except ValueError as exc:
+            raise NodeInputError(f"spec is not valid JSON: {exc}", where="spec") from None
+        try:
+            return fields_from_spec(spec, lo=lo, hi=hi, shape=shape, mesh=domain)
+        except ValueError as exc:
+            raise NodeInputError(f"spec: {exc}", where="spec") from None
+
+    @staticmethod
+    def _paint(fields, strokes, first):
+        """Apply every stroke; return the union box of those from index ``first`` on."""
+        changed = _EMPTY
+        for i, stroke in enumerate(strokes):
+            fields, box = apply_stroke(fields, stroke)
+            if i >= first:
+                changed = _union(changed, box)
+        return fields, changed
+
+
+# ------------------------------------------------------------------ PhasorNoise
+
+def _fields_digest(fields) -> str:
+    h = hashlib.sha256()
+    for a in (fields.direction, fields.frequency, fields.spread, fields.lo, fields.hi):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    return h.hexdigest()
+
+
+def _pack(a) -> str:
+    return base64.b64encode(zlib.compress(np.ascontiguousarray(a, "<f8").tobytes(), 6)).decode("ascii")
+
+
+def _unpack(text, n) -> np.ndarray:
+    a = np.frombuffer(zlib.decompress(base64.b64decode(text.encode("ascii"), validate=True)), "<f8")
+    if a.shape != (n,):
+        raise ValueError(f"expected {n} stored phases, found {a.size}")
+    return a.astype(np.float64)
+
+
+@register
+class PhasorNoiseNode(NodeType):
+    """Two phasor noises p_v, p_w from kernels sampled on the fields (8 per
+    cell of edge c / F_min), their phases aligned by `iterations` sweeps;
+    slices of the result use the filtered kernels when `filtered`. A repaint
+    resamples and re-aligns only the kernels near the repainted cells."""
+
+    type_name = "PhasorNoise"
+    title = "Phasor Noise"
+    code = "pn"
+    family = "topology"
+    uses_rng = True
+    stateful = True
+    inputs = (Port("fields", "PhasorFields"),)
+    outputs = (Port("infill", "PhasorInfill"),)
+    params = (
+        Param("per_cell", "int", 8, 1, 64, doc="kernels per grid cell (paper: 8)"),
+        Param("c", "float", 4.5, 0.5, 20.0, doc="kernel radius in periods of the lowest frequency "
+                                                "(paper: 4.5)"),
+        Param("iterations", "int", 20, 0, 200, doc="phase-alignment sweeps (paper: 20)"),
+        Param("filtered", "bool", True, doc="slices use the filtered kernels (fewer singularities)"),
+        Param("filter_scale", "float", 2.0, 0.1, 10.0, doc="filter radius in kernel radii"),
+    )
+
+    def evaluate(self, inputs, params, ctx):
+        from engine.phasor.incremental import changed_cells, update_infill
+        from engine.phasor.infill import sample_infill
+
+        fv = inputs["fields"]
+        fields = fv.fields
+        prev = ctx.previous.get("infill") if ctx.previous else None
+        pp = ctx.previous_params or {}
+        if (prev is not None and ctx.previous_seed == ctx.seed
+                and all(pp.get(k) == params[k] for k in ("per_cell", "c", "iterations"))
+                and params["c"] / fields.min_frequency() == prev.kernels.radius):
+            changed = changed_cells(prev.fields, fields)
+            if changed is not None:
+                infill = update_infill(prev, fields, changed, iterations=params["iterations"],
+                                       filtered=params["filtered"], filter_scale=params["filter_scale"],
+                                       progress=ctx.progress)
+                return {"infill": replace(infill, domain=fv.domain)}
+        try:
+            infill = sample_infill(fields, domain=fv.domain, per_cell=params["per_cell"], c=params["c"],
+                                   iterations=params["iterations"], filtered=params["filtered"],
+                                   filter_scale=params["filter_scale"], rng=ctx.seed,
+                                   progress=ctx.progress)
+        except ValueError as exc:  # too many kernels for the box and F_min
+            raise NodeInputError(str(exc), where="per_cell") from None
+        return {"infill": infill}
+
+    # The oscillators are what a fresh sample of the current fields gives (a
+    # resample reuses the same random draws), so only the phases, which carry
+    # the history of local re-alignments, are stored.
+    def encode_state(self, outputs):
+        infill = outputs["infill"]
+        k = infill.kernels
+        return {"n": k.n, "seed": k.seed, "per_cell": k.info.get("per_cell"), "c": k.info.get("c"),
+                "iterations": infill.iterations, "filtered": infill.filtered,
+                "filter_scale": infill.filter_scale, "fields_sha256": _fields_digest(infill.fields),
+                "phase_v": _pack(k.phase_v), "phase_w": _pack(k.phase_w)}
+
+    def decode_state(self, blob, inputs):
+        from engine.phasor.attenuation import attenuation_grid
+        from engine.phasor.infill import PhasorInfill
+        from engine.phasor.sampling import sample_kernels
+
+        fv = inputs.get("fields")
+        if fv is None:
+            raise ValueError("no fields are connected")
+        try:
+            n, seed, per_cell, c = int(blob["n"]), int(blob["seed"]), int(blob["per_cell"]), float(blob["c"])
+            digest = blob["fields_sha256"]
+            options = (int(blob["iterations"]), bool(blob["filtered"]), float(blob["filter_scale"]))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"malformed stored noise ({exc!r})") from None
+        if digest != _fields_digest(fv.fields):
+            raise ValueError("the fields changed since the noise was stored")
+        kernels = sample_kernels(fv.fields, per_cell=per_cell, c=c, rng=seed)
+        if kernels.n != n:
+            raise ValueError(f"expected {n} kernels, sampling gives {kernels.n}")
+        kernels = kernels.with_phases(_unpack(blob["phase_v"], n), _unpack(blob["phase_w"], n))
+        infill = PhasorInfill(kernels, fv.fields, fv.domain, options[1], options[2],
+                              attenuation_grid(fv.fields, radius=kernels.radius), options[0])
+        return {"infill": infill}
+
+
+# ------------------------------------------------------------------ PhasorSlice
+
+@register
+class PhasorSliceNode(NodeType):
+    """One axis-aligned slice of the infill, evaluated by the GPU shader (or
+    the numpy reference): the black diamond cells inside the part, either
+    sawtooth noise, or the singularity measure S; and the slice's
+    singularity energy F_S(2)."""
+
+    type_name = "PhasorSlice"
+    title = "Phasor Slice"
+    code = "ps"
+    family = "property"
+    inputs = (Port("infill", "PhasorInfill"),)
+    outputs = (Port("image", "Field"), Port("energy", "Energy"))
+    params = (
+        Param("axis", "enum", "z", choices=("x", "y", "z"), doc="the slice plane's normal"),
+        Param("position", "float", 0.0, unit="mm", doc="the plane's coordinate along axis"),
+        Param("pixel", "float", 0.1, 0.001, 10.0, unit="mm", doc="pixel size"),
+        Param("show", "enum", "diamonds", choices=SHOW,
+              doc="diamonds: 1 in black cells inside the part; p_v, p_w: sawtooth in [0, 1); "
+                  f"singularity: max(S_v, S_w), clipped at {SHOW_S_MAX:g}"),
+        Param("engine", "enum", "gpu", choices=("gpu", "numpy"),
+              doc="gpu: the shader (numpy when no EGL context can be made, logged); numpy: reference"),
+    )
+
+    def evaluate(self, inputs, params, ctx):
+        from engine.phasor.infill import SINGULARITY_THRESHOLD, check_pixel, infill_slice
+
+        infill = inputs["infill"]
+        try:
+            check_pixel(infill.fields, params["pixel"])
+        except ValueError as exc:
+            raise NodeInputError(str(exc), where="pixel") from None
+        try:
+            result = infill_slice(infill, params["axis"], params["position"], params["pixel"],
+                                  engine=params["engine"], progress=ctx.progress)
+        except ValueError as exc:
+            where = "position" if str(exc).startswith("position") else "infill"
+            raise NodeInputError(str(exc), where=where) from None
+        ctx.check()
+        energy = self._energy(result, SINGULARITY_THRESHOLD)
+        show = params["show"]
+        if show == "diamonds":
+            values = result.diamonds.astype(np.float64)
+        elif show in ("p_v", "p_w"):
+            values = getattr(result, show)
+        else:
+            s_v, s_w = result.singularity()
+            values = np.nan_to_num(np.clip(np.fmax(s_v, s_w), 0.0, SHOW_S_MAX), nan=0.0)
+        return {"image": Field(values, result.lo, result.hi), "energy": energy}
+
+    @staticmethod
+    def _energy(result, q):
+        try:
+            e = result.energy(q)
+        except ValueError:  # the slice misses the part
+            return SliceEnergy(math.nan, math.nan, math.nan, q, 0, result.state, result.engine)
+        return SliceEnergy(e["either"], e["v"], e["w"], q, e["pixels"], result.state, result.engine)
