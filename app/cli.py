@@ -7,7 +7,7 @@
     mesoforge homogenize INPUT [--E 1 --nu 0.45] [--res N] [--json]
     mesoforge grow TILESET --size 20x20 --out tiling.json [--png t.png] [--hints T=1,+=2] [--json]
     mesoforge study TILESET [--hints ...] [--n 100] [--out study.csv] [--scheduler ADDR] [--json]
-    mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--node ID]
+    mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--printability] [--node ID]
 """
 
 from __future__ import annotations

@@ -246,17 +246,6 @@ def _gcode_output(args, infill, out, settings) -> None:
                     "settings": settings.to_dict()}
 
 
-def print_toolpaths(infill, settings, *, pixel, engine="gpu", progress=None) -> list:
-    """The toolpath layers :func:`engine.phasor.infill.write_print` writes, as a list
-    of :class:`engine.fab.Layer` (``progress`` once per sliced layer)."""
-    from engine.fab import layer_stack_toolpaths
-    from engine.phasor.infill import print_layers
-
-    images = print_layers(infill, layer_height=settings.layer_height, pixel=pixel, engine=engine,
-                          progress=progress)
-    return list(layer_stack_toolpaths(images, settings=settings))
-
-
 def printability_summary(report, nozzle_diameter: float) -> dict:
     """The JSON-able totals and histograms of an :class:`engine.fab.PrintabilityReport`."""
     from engine.fab.printability import MAX_OVERLAP, MIN_SUPPORT
@@ -273,6 +262,7 @@ def printability_summary(report, nozzle_diameter: float) -> dict:
 
 
 def _printability_output(args, infill, out, settings) -> None:
+    from engine.phasor.infill import infill_toolpaths
     from engine.fab import printability, read_gcode_paths
     from engine.geometry.cancel import Cancelled
 
@@ -281,7 +271,7 @@ def _printability_output(args, infill, out, settings) -> None:
             layers = read_gcode_paths(args.gcode, offset=settings.offset)
         else:
             print("slicing the toolpaths of every layer", file=sys.stderr)
-            layers = print_toolpaths(infill, settings, pixel=args.px, engine=args.engine,
+            layers = infill_toolpaths(infill, settings, pixel=args.px, engine=args.engine,
                                      progress=_gcode_progress(sys.stderr))
         print(f"emulating the print of {len(layers)} layers", file=sys.stderr)
         report = printability(layers, nozzle_diameter=settings.nozzle_diameter,
@@ -335,10 +325,11 @@ def printability_table(p: dict) -> str:
 
 
 def run(args) -> int:
+    out = {}
     try:
         _check_args(args)
         nid, infill = _infill(args)
-        out = {"project": str(Path(args.project).resolve()), "node": nid}
+        out.update(project=str(Path(args.project).resolve()), node=nid)
         if args.slice and (args.png or args.json):
             _slice_outputs(args, infill, out)
         settings = _print_settings(args, infill) if (args.gcode or args.printability) else None
@@ -351,7 +342,7 @@ def run(args) -> int:
     except _Failed as exc:
         return _fail(str(exc), 1)
     except KeyboardInterrupt:
-        where = f"; {args.gcode} was not written" if args.gcode else ""
+        where = f"; {args.gcode} was not written" if args.gcode and "gcode" not in out else ""
         print(file=sys.stderr)
         return _fail(f"interrupted{where}", 130)
     if args.json:

@@ -564,7 +564,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @staticmethod
     def _export_arrays(solid: Solid, tiles: int) -> tuple[np.ndarray, np.ndarray]:
-        if tiles == 1:
+        if tiles == 1 or not solid.periodic:
             return np.asarray(solid.vertices), np.asarray(solid.faces)
         from engine.geometry.marching import periodic_mesh
         # One marching-cubes pass over the tiled field gives a watertight block

@@ -329,7 +329,7 @@ class PrintBox(QtWidgets.QGroupBox):
         if layers is None:
             if self.infill is None:
                 return
-            from app.phasor_cmd import print_toolpaths
+            from engine.phasor.infill import infill_toolpaths
             from engine.phasor.infill import MIN_PIXELS_PER_PERIOD
 
             infill, engine = self.infill, self.engine
@@ -337,7 +337,7 @@ class PrintBox(QtWidgets.QGroupBox):
             source = source or f"{self.name} ({settings.layer_height:g} mm layers)"
 
             def work(progress):
-                paths = print_toolpaths(infill, settings, pixel=pixel, engine=engine, progress=progress)
+                paths = infill_toolpaths(infill, settings, pixel=pixel, engine=engine, progress=progress)
                 return printability(paths, nozzle_diameter=nozzle, progress=progress)
         else:
             layers = list(layers)

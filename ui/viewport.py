@@ -292,7 +292,8 @@ class Viewport(QtWidgets.QWidget):
         self._sphere_points = 0
         self._sphere_note = ""
         c = self.cell_size()
-        offsets = tile_offsets(self.tiles, c)
+        tileable = self.solid is None or self.solid.periodic
+        offsets = tile_offsets(self.tiles if tileable else 1, c)
         if self.show_solid and self.solid is not None and len(self.solid.faces):
             v, f = tiled_arrays(self.solid.vertices, self.solid.faces, offsets)
             mesh = polydata(v, f)

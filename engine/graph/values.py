@@ -129,12 +129,15 @@ class Solid:
         exactly periodic, so opposite faces agree by construction.
     vertices, faces : the single-cell mesh from marching cubes (closed).
     cell_size : edge of the unit cell in model units (mm).
+    periodic : False for a solid that is not a tileable cell (a preview of a
+        sub-box of a part): it is shown and exported once, never tiled.
     """
 
     sdf: np.ndarray
     vertices: np.ndarray
     faces: np.ndarray
     cell_size: float = 1.0
+    periodic: bool = True
 
     def __post_init__(self):
         object.__setattr__(self, "sdf", _frozen(self.sdf, np.float32))

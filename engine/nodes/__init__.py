@@ -1,3 +1,4 @@
 """Node types.  Importing this package registers them all."""
 
 from . import growth, lines, phasor, properties, solids, topology, transforms  # noqa: F401
+from . import phasor_preview  # noqa: F401

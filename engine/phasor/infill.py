@@ -398,3 +398,13 @@ def write_print(infill: PhasorInfill, path, *, settings=None, pixel: float = 0.1
     zs = layer_positions(infill, settings.layer_height)
     layers = print_layers(infill, layer_height=settings.layer_height, pixel=pixel, engine=engine)
     return layers_to_gcode(layers, path, settings=settings, n_layers=len(zs), progress=progress)
+
+
+def infill_toolpaths(infill, settings, *, pixel, engine="gpu", progress=None) -> list:
+    """The toolpath layers :func:`engine.phasor.infill.write_print` writes, as a list
+    of :class:`engine.fab.Layer` (``progress`` once per sliced layer)."""
+    from engine.fab import layer_stack_toolpaths
+
+    images = print_layers(infill, layer_height=settings.layer_height, pixel=pixel, engine=engine,
+                          progress=progress)
+    return list(layer_stack_toolpaths(images, settings=settings))
