@@ -25,7 +25,7 @@ __all__ = ["load_domain_mesh", "check_closed", "inside_mask", "domain_grid", "sl
            "box_of"]
 
 
-def _arrays(mesh):
+def mesh_arrays(mesh):
     """(vertices (v, 3) float64, faces (f, 3) int64) of a trimesh or a (v, f) pair."""
     if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
         v, f = mesh.vertices, mesh.faces
@@ -49,7 +49,7 @@ def check_closed(vertices, faces) -> None:
     Every undirected edge must belong to exactly two faces that traverse it
     in opposite directions, and the enclosed volume must be non-zero.
     """
-    v, f = _arrays((vertices, faces))
+    v, f = mesh_arrays((vertices, faces))
     directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     undirected = np.sort(directed, axis=1)
     edges, counts = np.unique(undirected, axis=0, return_counts=True)
@@ -116,7 +116,7 @@ def inside_mask(mesh, points) -> np.ndarray:
     """
     import igl
 
-    v, f = _arrays(mesh)
+    v, f = mesh_arrays(mesh)
     q = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
     if len(q) == 0:
         return np.zeros(0, dtype=bool)
@@ -190,7 +190,7 @@ def slice_domain(mesh, axis, position, *, lo, hi, shape) -> np.ndarray:
     if lo.shape != (2,) or hi.shape != (2,) or np.any(~(hi > lo)) or len(shape) != 2 or min(shape) < 1:
         raise ValueError(f"pixel grid: expected lo < hi (2 numbers each, mm) and shape (H, W) >= 1; "
                          f"got {lo.tolist()}, {hi.tolist()}, {shape}")
-    v, f = _arrays(mesh)
+    v, f = mesh_arrays(mesh)
     seg = _section(v, f, axis, float(position))
     h, w = shape
     us = lo[0] + (np.arange(w) + 0.5) * (hi[0] - lo[0]) / w
@@ -229,5 +229,5 @@ def box_of(mesh, margin: float = 0.0):
     if isinstance(margin, bool) or not isinstance(margin, (int, float, np.floating)) \
             or not math.isfinite(margin) or margin < 0:
         raise ValueError(f"margin: expected a finite number >= 0 mm, got {margin!r}")
-    v, _ = _arrays(mesh)
+    v, _ = mesh_arrays(mesh)
     return v.min(axis=0) - margin, v.max(axis=0) + margin

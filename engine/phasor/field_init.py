@@ -52,6 +52,7 @@ import math
 
 import numpy as np
 
+from engine.phasor.domain import mesh_arrays
 from engine.phasor.fields import MAX_SPREAD, PhasorFields
 
 __all__ = ["fields_from_spec", "D_KINDS", "SCALAR_KINDS", "DEFAULT_SPEC"]
@@ -236,25 +237,12 @@ def _direction(entry, p, lo, hi, mesh):
     return _surface_normal(entry, p, mesh)
 
 
-def _mesh_arrays(mesh):
-    if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
-        v, f = mesh.vertices, mesh.faces
-    else:
-        v, f = mesh
-    v = np.ascontiguousarray(v, dtype=np.float64)
-    f = np.ascontiguousarray(f, dtype=np.int64)
-    if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3 or len(f) == 0:
-        raise ValueError(f"mesh: expected (v, 3) vertices and non-empty (f, 3) faces, got "
-                         f"{v.shape} and {f.shape}")
-    return v, f
-
-
 def _surface_normal(entry, p, mesh):
     import igl
 
     if mesh is None:
         raise ValueError("D.kind: 'surface_normal' needs the part's mesh; pass mesh=")
-    v, f = _mesh_arrays(mesh)
+    v, f = mesh_arrays(mesh)
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     volume = float(np.einsum("ij,ij->i", v[f[:, 0]], normals).sum()) / 6.0
     length = np.linalg.norm(normals, axis=1, keepdims=True)
