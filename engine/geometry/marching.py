@@ -105,14 +105,14 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     inner = tuple(slice(pad, grid.shape[a] - pad) for a in range(3))
     grid[inner] = f[np.ix_(*axes)]
 
-    verts, faces = _slab_marching_cubes(grid, float(lv32), progress)
+    verts, faces = slab_marching_cubes(grid, float(lv32), progress)
     spacing = cs / np.array(f.shape, dtype=np.float64)
     extent = cs * np.array(t, dtype=np.float64)
     verts = (verts.astype(np.float64) - pad) * spacing
     faces = faces.astype(np.int64)
     if closed:
         verts = np.clip(verts, 0.0, extent)
-        verts, faces = _weld_clipped(verts, faces, extent)
+        verts, faces = weld_clipped(verts, faces, extent)
         verts, faces = drop_specks(verts, faces, 0.5 * float(np.prod(spacing)))
     return verts, faces
 
@@ -157,7 +157,7 @@ def drop_specks(vertices, faces, min_volume):
 _SLAB_CELLS = 24
 
 
-def _slab_marching_cubes(grid, level, progress):
+def slab_marching_cubes(grid, level, progress):
     """Marching cubes over slabs along x, welded on the shared planes.
 
     Slabs share their boundary plane of samples, so the vertices on it are
@@ -199,7 +199,7 @@ def _slab_marching_cubes(grid, level, progress):
     return verts[used], (np.cumsum(used) - 1)[faces]
 
 
-def _weld_clipped(verts, faces, extent):
+def weld_clipped(verts, faces, extent):
     """Merge vertices that clipping made identical; drop collapsed triangles.
 
     A node on a box edge (corner) has two (three) pad neighbours; the

@@ -224,7 +224,7 @@ def diamond_surface(volume: DiamondVolume, *, progress=None) -> tuple:
     faces : (f, 3) int64, counter-clockwise seen from outside the cells;
         empty when no node lies in a cell
     """
-    from engine.geometry.marching import _slab_marching_cubes, _weld_clipped, drop_specks
+    from engine.geometry.marching import slab_marching_cubes, weld_clipped, drop_specks
 
     f = np.array(volume.indicator, dtype=np.float32)
     # A node exactly on the level would put several vertices at one point and
@@ -238,10 +238,10 @@ def diamond_surface(volume: DiamondVolume, *, progress=None) -> tuple:
     # clipped back onto the sub-box's faces, which caps the cells there.
     grid = np.full(np.add(f.shape, 2), np.float32(10.0), dtype=np.float32)
     grid[1:-1, 1:-1, 1:-1] = f
-    verts, faces = _slab_marching_cubes(grid, 0.0, progress)
+    verts, faces = slab_marching_cubes(grid, 0.0, progress)
     spacing = volume.spacing
     extent = (np.array(f.shape) - 1) * spacing
     verts = np.clip((verts.astype(np.float64) - 1.0) * spacing, 0.0, extent)
-    verts, faces = _weld_clipped(verts, faces.astype(np.int64), extent)
+    verts, faces = weld_clipped(verts, faces.astype(np.int64), extent)
     verts, faces = drop_specks(verts, faces, 0.5 * float(np.prod(spacing)))
     return verts + volume.lo, faces

@@ -165,7 +165,7 @@ def test_slab_meshing_equals_one_marching_cubes_call_and_cancels():
 
     rng = np.random.default_rng(5)
     field = np.asarray(rng.normal(size=(60, 20, 20)), np.float32)
-    v1, f1 = marching._slab_marching_cubes(field, 0.0, None)
+    v1, f1 = marching.slab_marching_cubes(field, 0.0, None)
     v2, f2, _, _ = marching_cubes(field, level=0.0, gradient_direction="descent", allow_degenerate=True)
     from scipy.spatial import cKDTree
 

@@ -1,0 +1,1 @@
+"""Reaction/diffusion lattice synthesis (Garnier, Schmidt & Rohmer): inputs, growth, compilation."""
