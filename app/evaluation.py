@@ -70,12 +70,33 @@ def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
     return MeshResult(v, f, s)
 
 
+# What `eval --json` tells about each Surface node's solve (from its SurfaceReport).
+SURFACE_KEYS = ("solver", "iterations", "energy", "area", "max_abs_H", "mean_abs_H", "converged", "warning")
+
+
+def surface_entry(report: EvalReport, nid: str) -> dict:
+    """Solver, iterations, final energy, area and max / mean |H| of a Surface node
+    (or its status and error when it produced no report)."""
+    r = report.results[nid]
+    value = (report.outputs.get(nid) or {}).get("report")
+    entry = {"status": r.status}
+    if value is None:
+        entry["error"] = r.error
+        return entry
+    summary = value.summary()
+    entry.update({k: summary[k] for k in SURFACE_KEYS})
+    return entry
+
+
 def report_json(doc: GraphDocument, report: EvalReport) -> dict:
     nodes = []
+    surfaces = {}
     for nid in doc.topological_order():
         r = report.results.get(nid)
         if r is None:
             continue
+        if doc.nodes[nid].type_name == "Surface":
+            surfaces[nid] = surface_entry(report, nid)
         entry = {"id": nid, "type": doc.nodes[nid].type_name, "status": r.status,
                  "seconds": round(r.seconds, 6)}
         for port, value in (report.outputs.get(nid) or {}).items():
@@ -89,6 +110,8 @@ def report_json(doc: GraphDocument, report: EvalReport) -> dict:
     out = {"ok": report.ok, "seconds": round(report.seconds, 6), "cache_hits": report.cache_hits,
            "evaluated": sum(r.status == "evaluated" for r in report.results.values()),
            "failed": sorted(report.errors), "nodes": nodes}
+    if surfaces:
+        out["surfaces"] = surfaces
     warnings = list(doc.load_warnings) + list(report.warnings.values())
     if warnings:
         out["warnings"] = warnings

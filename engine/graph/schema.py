@@ -32,6 +32,11 @@ PORT_TYPES = (
     "PhasorFields",
     "PhasorInfill",
     "Energy",
+    "Design",
+    "RDFields",
+    "RDStructures",
+    "Contour",
+    "SurfaceReport",
 )
 
 PARAM_KINDS = ("float", "int", "bool", "enum", "vec3", "str", "samples", "int_list", "json")

@@ -373,3 +373,239 @@ class SliceEnergy:
     def summary(self) -> dict:
         return {"F_S": self.value, "F_S_v": self.v, "F_S_w": self.w, "q": self.q,
                 "pixels": self.pixels, "state": self.state, "engine": self.engine}
+
+
+# ---------------------------------------------------------------- reaction-diffusion growth
+# (Garnier, Schmidt & Rohmer 2022).  Grids are indexed [y, x] / [z, y, x];
+# tensor and rotation components are ordered (x, y[, z]).
+
+
+@dataclass(frozen=True, eq=False)
+class DesignValue:
+    """A topology-optimised design (port type "Design").
+
+    rho : grid_shape float64, read-only, element densities in [0, 1].
+    sigma : (n_cases,) + grid_shape + (d, d) float64, read-only, element
+        stress tensors per load case (components (x, y[, z])).
+    sigma_combined : grid_shape + (d, d) float64, read-only, the tensor that
+        orients the growth (the single case's stress, or the load cases
+        combined / the optimised orientation for several cases).
+    rotation : grid_shape + (d, d) float64, read-only, columns = principal
+        directions sorted by |sigma_i| descending.
+    principal : grid_shape + (d,) float64, read-only, the principal values
+        of ``sigma_combined`` along the columns of ``rotation``.
+    problem : the engine's topology-optimisation problem (JSON-able).
+    result : the optimiser's own result object (history, compliance, timing).
+    lo, hi : (d,) float64, the design box in element units, (x, y[, z]).
+    seconds : float, wall time of the optimisation.
+    """
+
+    rho: np.ndarray
+    sigma: np.ndarray
+    sigma_combined: np.ndarray
+    rotation: np.ndarray
+    principal: np.ndarray
+    problem: object
+    result: object = None
+    lo: np.ndarray | None = None
+    hi: np.ndarray | None = None
+    seconds: float = 0.0
+
+    def __post_init__(self):
+        for name in ("rho", "sigma", "sigma_combined", "rotation", "principal"):
+            object.__setattr__(self, name, _read_only(getattr(self, name), np.float64))
+        d = self.rho.ndim
+        lo = np.zeros(d) if self.lo is None else self.lo
+        hi = np.array(self.rho.shape[::-1], float) if self.hi is None else self.hi
+        object.__setattr__(self, "lo", _frozen(lo).reshape(d))
+        object.__setattr__(self, "hi", _frozen(hi).reshape(d))
+
+    @property
+    def ndim(self) -> int:
+        return int(self.rho.ndim)
+
+    @property
+    def grid_shape(self) -> tuple:
+        return tuple(self.rho.shape)
+
+
+@dataclass(frozen=True, eq=False)
+class RDFieldsValue:
+    """Inputs of reaction-diffusion growth (port type "RDFields").
+
+    rho : grid_shape float64, read-only, infill-space density in [0, 1].
+    rotation : grid_shape + (d, d) float64, read-only, principal directions
+        as columns (x, y[, z]), sorted by |sigma_i| descending.
+    gamma : grid_shape float64, read-only, infill map Gamma in [0, 1]
+        (1 = fill with solid material).
+    lo, hi : (d,) float64, the box the grid covers, (x, y[, z]).
+    sigma : grid_shape + (d, d) float64 or None, the tensor the rotation came
+        from (for display).
+    gamma_sigma : grid_shape float64 or None, the coherence part of Gamma.
+    magnitude : grid_shape + (d,) float64 or None, |principal value| along
+        each column of ``rotation`` (None when only directions were given).
+    source : RDFieldsValue or None, the fields these were upsampled from
+        (None: these are the fields as made).
+    """
+
+    rho: np.ndarray
+    rotation: np.ndarray
+    gamma: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    sigma: np.ndarray | None = None
+    gamma_sigma: np.ndarray | None = None
+    magnitude: np.ndarray | None = None
+    source: "RDFieldsValue | None" = None
+
+    def __post_init__(self):
+        for name in ("rho", "rotation", "gamma", "sigma", "gamma_sigma", "magnitude"):
+            a = getattr(self, name)
+            if a is not None:
+                object.__setattr__(self, name, _read_only(a, np.float64))
+        object.__setattr__(self, "lo", _frozen(self.lo).reshape(-1))
+        object.__setattr__(self, "hi", _frozen(self.hi).reshape(-1))
+        d = self.rho.ndim
+        if self.rotation.shape != self.rho.shape + (d, d) or self.gamma.shape != self.rho.shape \
+                or self.lo.size != d or self.hi.size != d:
+            raise ValueError(f"RDFieldsValue: rho {self.rho.shape}, rotation {self.rotation.shape}, "
+                             f"gamma {self.gamma.shape} and a {self.lo.size}D box do not fit together")
+
+    @property
+    def ndim(self) -> int:
+        return int(self.rho.ndim)
+
+    @property
+    def grid_shape(self) -> tuple:
+        return tuple(self.rho.shape)
+
+    def source_of(self) -> "RDFieldsValue":
+        """The fields as made (before any upsampling)."""
+        return self if self.source is None else self.source
+
+    def same_as(self, other: "RDFieldsValue") -> bool:
+        """Whether ``other`` holds the same rho, rotation and Gamma on the same box."""
+        if other is self:
+            return True
+        return (other is not None and self.grid_shape == other.grid_shape
+                and all(np.array_equal(getattr(self, n), getattr(other, n))
+                        for n in ("rho", "rotation", "gamma", "lo", "hi")))
+
+
+@dataclass(frozen=True, eq=False)
+class RDStructuresValue:
+    """Per-direction structures grown by anisotropic Gray-Scott (port type "RDStructures").
+
+    s : (n,) + grid_shape float32, read-only, s_i = 1 - u_i for each grown
+        direction (in ``directions`` order).
+    directions : tuple of int, the principal direction of each structure.
+    fields : RDFieldsValue on the growth grid (rho, rotation, Gamma upsampled;
+        ``fields.source_of()`` is the node's input).
+    iso : float, the infill space is ``fields.rho >= iso``.
+    steps : tuple of int, steps of each direction's state (regrowth included).
+    stop_reasons : tuple of str, why each direction's last run stopped
+        ("converged", "max_steps", "cancelled").
+    stop_steps : tuple of int, the step each direction's last run stopped at.
+    g_history : tuple of (m, 2) float64 arrays, (step, G^t) of eq. 14 per direction.
+    seconds : tuple of float, wall time of each direction's last run.
+    cell_updates_per_second : float, grid cells x steps / seconds over the last runs.
+    states : tuple, per direction the resumable kernel state
+        (``engine.rd.growth.RDState``), or None.
+    edits : tuple of dict, the brush edits applied so far.
+    regrown : bool, the last evaluation regrew locally after edits.
+    changed : tuple of (start, stop) per grid axis or None, the box the last
+        evaluation could change (None: everything).
+    """
+
+    s: np.ndarray
+    directions: tuple
+    fields: RDFieldsValue
+    iso: float = 0.5
+    steps: tuple = ()
+    stop_reasons: tuple = ()
+    stop_steps: tuple = ()
+    g_history: tuple = ()
+    seconds: tuple = ()
+    cell_updates_per_second: float = 0.0
+    states: tuple | None = None
+    edits: tuple = ()
+    regrown: bool = False
+    changed: tuple | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "s", _read_only(self.s, np.float32))
+        object.__setattr__(self, "g_history", tuple(_read_only(g, np.float64).reshape(-1, 2)
+                                                    for g in self.g_history))
+        if self.s.shape[1:] != self.fields.grid_shape or self.s.shape[0] != len(self.directions):
+            raise ValueError(f"RDStructuresValue: s {self.s.shape} does not fit {len(self.directions)} "
+                             f"directions on grid {self.fields.grid_shape}")
+
+    @property
+    def ndim(self) -> int:
+        return self.fields.ndim
+
+    def summary(self) -> dict:
+        """JSON-able facts of the growth, per direction."""
+        return {"grid": list(self.fields.grid_shape[::-1]), "directions": list(self.directions),
+                "steps": list(self.steps), "stop_reasons": list(self.stop_reasons),
+                "stop_steps": list(self.stop_steps), "seconds": list(self.seconds),
+                "final_g": [float(g[-1, 1]) if len(g) else None for g in self.g_history],
+                "cell_updates_per_second": self.cell_updates_per_second,
+                "regrown": self.regrown, "edits": len(self.edits)}
+
+
+@dataclass(frozen=True)
+class ContourValue:
+    """2D iso-contours of a compiled lattice (port type "Contour").
+
+    polylines : tuple of (m, 2) float64 arrays, read-only, points (x, y) in
+        the box's units; a closed loop repeats its first point.
+    lo, hi : (2,) float64, the box.
+    iso : float, the level contoured.
+    """
+
+    polylines: tuple
+    lo: np.ndarray
+    hi: np.ndarray
+    iso: float = 0.5
+
+    def __post_init__(self):
+        object.__setattr__(self, "polylines", tuple(_frozen(p).reshape(-1, 2) for p in self.polylines))
+        object.__setattr__(self, "lo", _frozen(self.lo).reshape(2))
+        object.__setattr__(self, "hi", _frozen(self.hi).reshape(2))
+
+
+@dataclass(frozen=True)
+class SurfaceReport:
+    """How a Surface node solved its patch (port type "SurfaceReport").
+
+    solver : "direct" (thin shell), "mixed_minimal" or "conjugate".
+    iterations : solver steps (L-BFGS iterations, flow steps, Nelder-Mead
+        iterations of the edge-length search).
+    energy : final value of the solver's energy: the shell energy
+        (in-plane + alpha * bending, dimensionless), the area (cell units^2)
+        or the conjugate contour energy (dimensionless).
+    area : patch area (cell units^2); max_abs_H, mean_abs_H : mean curvature
+        over interior vertices (1 / cell units), the mean area-weighted.
+    seconds : wall time of the solve (thickness profile included).
+    converged : the solver met its tolerance within max_iter.
+    warning : why the result may be unreliable ("" when converged).
+    details : further JSON-able facts (FBV, sliding planes, vertex count...).
+    """
+
+    solver: str
+    iterations: int
+    energy: float
+    area: float
+    max_abs_H: float
+    mean_abs_H: float
+    seconds: float
+    converged: bool = True
+    warning: str = ""
+    details: dict = field(default_factory=dict, compare=False)
+
+    def summary(self) -> dict:
+        return {"solver": self.solver, "iterations": self.iterations, "energy": self.energy,
+                "area": self.area, "max_abs_H": self.max_abs_H, "mean_abs_H": self.mean_abs_H,
+                "seconds": self.seconds, "converged": self.converged, "warning": self.warning,
+                "details": dict(self.details)}

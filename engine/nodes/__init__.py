@@ -2,3 +2,4 @@
 
 from . import growth, lines, phasor, properties, solids, topology, transforms  # noqa: F401
 from . import phasor_preview  # noqa: F401
+from . import surfaces  # noqa: F401
