@@ -8,6 +8,8 @@
     mesoforge grow TILESET --size 20x20 --out tiling.json [--png t.png] [--hints T=1,+=2] [--json]
     mesoforge study TILESET [--hints ...] [--n 100] [--out study.csv] [--scheduler ADDR] [--json]
     mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--printability] [--node ID]
+    mesoforge rd --preset cantilever|lbeam|bridge|mbb3d [--res WxH[xD]] [--grow-res WxH[xD]] --out OUT.png|OUT.stl
+                 [--fields FILE.npz|.vti] [--seed N] [--json]
 """
 
 from __future__ import annotations
@@ -171,6 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
     growth_cmd.add_parsers(sub)
     from app import phasor_cmd
     phasor_cmd.add_parsers(sub)
+    from app import rd_cmd
+    rd_cmd.add_parsers(sub)
     return p
 
 
@@ -194,6 +198,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "phasor":
         from app import phasor_cmd
         return phasor_cmd.run(args)
+    if args.command == "rd":
+        from app import rd_cmd
+        return rd_cmd.run(args)
     build_parser().print_help()
     return 2
 

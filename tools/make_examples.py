@@ -21,7 +21,8 @@ lines, transforms ..., objects, CSG, voxel) so the editor shows a tidy graph.
 Usage::
 
     python tools/make_examples.py                  # all examples
-    python tools/make_examples.py --only octet bcc # a subset (phasor_slab: the phasor infill example)
+    python tools/make_examples.py --only octet bcc # a subset (phasor_slab: the phasor infill example,
+                                                   # rd_cantilever: the reaction-diffusion one)
     python tools/make_examples.py --out /tmp/ex    # somewhere else
 
 The test ``tests/resources/test_examples.py`` regenerates the files and
@@ -627,6 +628,60 @@ def write_phasor_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dic
     return written
 
 
+# =============================================================== reaction-diffusion examples
+#
+# Not unit cells: a topology-optimised part filled with lattices grown by
+# anisotropic Gray-Scott reaction-diffusion along its principal stress
+# directions (Garnier, Schmidt & Rohmer 2022).  A painted solid region is one
+# SetParam of the whole stamp list, as the RD dock pushes it.
+
+def rd_cantilever() -> GraphDocument:
+    from engine.graph import SetParam
+
+    doc = GraphDocument(seed=0)
+    doc.meta = {"example": "rd_cantilever", "title": "Reaction-diffusion: stress-aligned cantilever",
+                "source": "Garnier, Schmidt & Rohmer 2022 (reaction-diffusion growth)", "paper_node_count": None,
+                "description": "A 2:1 cantilever clamped on the left and loaded at the middle of its right "
+                               "edge, optimised by SIMP on 64 x 32 elements (volume fraction 0.4). Its "
+                               "principal stress directions, regularised, orient one Gray-Scott growth per "
+                               "direction on a 320 x 160 grid from a seed at the middle of the part; a "
+                               "painted solid region keeps the load point full. The compiled lattice is "
+                               "the union of the two stripe families at iso 0.7 (paper Fig. 11)."}
+    stack = UndoStack(doc)
+    stack.push(AddNode("TopOpt", {"preset": "cantilever", "resolution": [64, 32], "max_iter": 60},
+                       (0.0, 0.0), node_id="topopt"))
+    stack.push(AddNode("RDFields", {"regularise": True, "coherence": True}, (COLUMN_WIDTH, 0.0),
+                       node_id="fields"))
+    stack.push(AddNode("RDGrow", {"resolution": [640, 320], "max_steps": 20000}, (2 * COLUMN_WIDTH, 0.0),
+                       node_id="grow"))
+    stack.push(AddNode("RDCompile", {"iso": 0.7}, (3 * COLUMN_WIDTH, 0.0), node_id="compile"))
+    stack.push(Connect("topopt", "design", "fields", "design"))
+    stack.push(Connect("fields", "rdfields", "grow", "rdfields"))
+    stack.push(Connect("grow", "structures", "compile", "structures"))
+    # the load point, painted solid in cells of the 64 x 32 design grid
+    stroke = [{"centre": [62.0, y], "radius": 2.5, "value": 1.0} for y in (14.5, 16.0, 17.5)]
+    stack.push(SetParam("fields", "gamma_c", doc.node("fields").params["gamma_c"] + [stroke]))
+    return doc
+
+
+RD_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
+    "rd_cantilever": rd_cantilever,
+}
+
+
+def write_rd_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
+    """Build the reaction-diffusion examples (all, or `names`) as ``<out_dir>/<name>.json``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = {}
+    for name in names or RD_EXAMPLES:
+        doc = RD_EXAMPLES[name]()
+        path = out / f"{name}.json"
+        save_project(doc, path)
+        written[path] = doc
+    return written
+
+
 def build(name: str) -> GraphDocument:
     """The example `name` as a fresh GraphDocument."""
     return EXAMPLES[name]().document()
@@ -648,13 +703,16 @@ def write_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path,
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=str(EXAMPLES_DIR), help="output folder (default: resources/examples)")
-    parser.add_argument("--only", nargs="+", choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES),
+    parser.add_argument("--only", nargs="+",
+                        choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES) + sorted(RD_EXAMPLES),
                         help="build only these examples")
     args = parser.parse_args(argv)
     cells = [n for n in args.only or EXAMPLES if n in EXAMPLES]
     phasor = [n for n in args.only or PHASOR_EXAMPLES if n in PHASOR_EXAMPLES]
+    rd = [n for n in args.only or RD_EXAMPLES if n in RD_EXAMPLES]
     written = {**(write_examples(args.out, cells) if cells else {}),
-               **(write_phasor_examples(args.out, phasor) if phasor else {})}
+               **(write_phasor_examples(args.out, phasor) if phasor else {}),
+               **(write_rd_examples(args.out, rd) if rd else {})}
     for path, doc in written.items():
         paper = doc.meta["paper_node_count"]
         print(f"{path}  ({len(doc.nodes)} nodes; paper: {paper if paper is not None else '-'})")

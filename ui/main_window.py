@@ -25,6 +25,7 @@ from .dialogs import MESH_FILTERS, Prompter
 from .eval_worker import EvalWorker
 from .growth_panel import GrowthPanel
 from .phasor_panel import PhasorPanel
+from .rd_panel import RDPanel
 from .study_panel import StudyPanel
 from .tileset_editor import TileSetEditor
 from .inspector import Inspector
@@ -118,6 +119,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.phasor_dock = self._dock("Phasor Infill", self.phasor_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.phasor_dock)
         self.phasor_panel.preview_lines.connect(self.viewport.show_toolpaths)
+        self.rd_panel = RDPanel(self.doc, self.undo, self)
+        self.rd_dock = self._dock("Reaction Diffusion", self.rd_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.rd_dock)
+        self.rd_panel.evaluate_requested.connect(self.evaluate_now)
         self.study_panel = StudyPanel(self)
         self.study_dock = self._dock("Studies", self.study_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.study_dock)
@@ -418,6 +423,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.shown_stiffness_id = stiffness_id
         self.growth_panel.set_context(self.doc, outputs, sel)
         self.phasor_panel.set_context(self.doc, outputs, sel)
+        self.rd_panel.set_context(self.doc, outputs, sel)
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
                                   skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
                                   sphere_caption=sphere_caption)
@@ -636,6 +642,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._autosave_timer.stop()
         self.growth_panel.detach()
         self.phasor_panel.shutdown()
+        self.rd_panel.shutdown()
         self.worker.shutdown()
         self.editor.detach()
         self.inspector.detach()

@@ -505,10 +505,15 @@ class RDStructuresValue:
     steps : tuple of int, steps of each direction's state (regrowth included).
     stop_reasons : tuple of str, why each direction's last run stopped
         ("converged", "max_steps", "cancelled").
-    stop_steps : tuple of int, the step each direction's last run stopped at.
-    g_history : tuple of (m, 2) float64 arrays, (step, G^t) of eq. 14 per direction.
+    stop_steps : tuple of int, where each direction's last run stopped: steps
+        from the seeds (a growth) or from the brush (a regrowth).
+    g_history : tuple of (m, 2) float64 arrays, (step, G^t) of eq. 14 of each
+        direction's last run (steps counted as in ``stop_steps``).
     seconds : tuple of float, wall time of each direction's last run.
-    cell_updates_per_second : float, grid cells x steps / seconds over the last runs.
+    cell_updates_per_second : float, cells x steps / seconds over the last
+        runs: the whole grid for a growth (the kernel skips cells the pattern
+        has not reached, so this is an effective rate), the regrown windows
+        for a regrowth.
     states : tuple, per direction the resumable kernel state
         (``engine.rd.growth.RDState``), or None.
     edits : tuple of dict, the brush edits applied so far.
