@@ -8,7 +8,7 @@
 Runs the graph TopOpt -> RDFields -> RDGrow -> RDCompile (the nodes the
 window uses): a SIMP optimisation of the preset on ``--res`` elements (or
 the fields imported from ``--fields`` instead), one Gray-Scott growth per
-principal direction on ``--grow-res`` cells (default: four times ``--res``
+principal direction on ``--grow-res`` cells (default: ten times ``--res``
 per axis in 2D, twice in 3D), then the compiled lattice: a PNG (2D; black
 = solid, +y up) or a closed STL (3D; in TopOpt elements).  ``--json`` prints the
 optimisation and growth times, steps, cell updates per second and, per
@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 PRESETS = ("cantilever", "lbeam", "lbeam_stress", "bridge", "bridge_multi", "mbb3d")
-UPSAMPLE = {2: 4, 3: 2}      # default growth grid per TopOpt element and axis
+UPSAMPLE = {2: 10, 3: 2}      # default growth grid per TopOpt element and axis
 
 
 class _BadInput(ValueError):
@@ -44,7 +44,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--preset", choices=PRESETS, default="cantilever",
                    help="topology-optimisation problem (default cantilever)")
     p.add_argument("--res", help="optimisation elements WxH (2D) or WxHxD (3D); default: the preset's")
-    p.add_argument("--grow-res", help="growth grid WxH[xD] (default: 4x --res in 2D, 2x in 3D)")
+    p.add_argument("--grow-res", help="growth grid WxH[xD] (default: 10x --res in 2D, 2x in 3D)")
     p.add_argument("--out", required=True, help="the lattice: .png (2D) or .stl (3D)")
     p.add_argument("--fields", help="grow in fields read from an .npz / .vti file instead of optimising")
     p.add_argument("--seed", type=int, default=0, help="document seed (default 0)")
