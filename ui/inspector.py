@@ -297,28 +297,76 @@ class SamplesEditor(ParamEditor):
         self._blocked([self.table], apply)
 
 
+class JsonTextDialog(QtWidgets.QDialog):
+    """Edit JSON as text; malformed text is refused in the dialog, which stays
+    open with everything typed."""
+
+    def __init__(self, title: str, value, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle(title)
+        self.value = value
+        lay = QtWidgets.QVBoxLayout(self)
+        self.text = QtWidgets.QPlainTextEdit(json.dumps(value, indent=1))
+        self.text.setMinimumSize(420, 260)
+        self.error = QtWidgets.QLabel()
+        self.error.setStyleSheet("color: #c03030;")
+        self.error.setWordWrap(True)
+        buttons = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.StandardButton.Ok
+                                             | QtWidgets.QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self.try_accept)
+        buttons.rejected.connect(self.reject)
+        lay.addWidget(self.text, 1)
+        lay.addWidget(self.error)
+        lay.addWidget(buttons)
+
+    def try_accept(self) -> bool:
+        try:
+            self.value = json.loads(self.text.toPlainText())
+        except ValueError as exc:
+            self.error.setText(f"not valid JSON: {exc}")
+            return False
+        self.accept()
+        return True
+
+
 class JsonEditor(ParamEditor):
-    """Structured data made by gestures elsewhere (e.g. brush strokes): shown as a
-    summary; a list can be cleared in one undoable step."""
+    """Structured data (brush strokes, loads and supports...): shown as a summary,
+    edited as JSON text in a dialog, or cleared, each one undoable step."""
 
     def _build(self):
         w = QtWidgets.QWidget()
         row = QtWidgets.QHBoxLayout(w)
         row.setContentsMargins(0, 0, 0, 0)
+        self.value = None
         self.label = QtWidgets.QLabel()
+        self.edit_button = QtWidgets.QPushButton("Edit…")
+        self.edit_button.clicked.connect(self.open_dialog)
         self.clear_button = QtWidgets.QPushButton("Clear")
-        self.clear_button.clicked.connect(lambda: self.edited.emit([]))
+        self.clear_button.clicked.connect(lambda: self.edited.emit({} if isinstance(self.value, dict) else []))
+        self.dialog: JsonTextDialog | None = None
         row.addWidget(self.label, 1)
+        row.addWidget(self.edit_button)
         row.addWidget(self.clear_button)
         return w
 
+    def open_dialog(self, *, modal: bool = True) -> JsonTextDialog:
+        """The JSON text dialog; with ``modal=False`` (tests) it is shown and returned."""
+        self.dialog = JsonTextDialog(f"Edit {self.param.name}", self.value, self.widget)
+        self.dialog.accepted.connect(lambda: self.edited.emit(self.dialog.value))
+        if modal:
+            self.dialog.exec()
+        else:
+            self.dialog.show()
+        return self.dialog
+
     def set_value(self, value):
+        self.value = value
         if isinstance(value, list):
             self.label.setText(f"{len(value)} item{'s' if len(value) != 1 else ''}")
         else:
             text = json.dumps(value)
             self.label.setText(text if len(text) <= 60 else text[:57] + "...")
-        self.clear_button.setEnabled(isinstance(value, list) and bool(value))
+        self.clear_button.setEnabled(isinstance(value, (list, dict)) and bool(value))
 
 
 EDITORS = {

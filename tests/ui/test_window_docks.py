@@ -1,5 +1,7 @@
 """The virtual-growth docks live in the window and act on its document."""
 
+import json
+
 from PySide6 import QtWidgets
 
 from engine.graph import AddNode
@@ -39,3 +41,20 @@ def test_phasor_example_paints_in_the_window_and_toolpaths_show_in_the_viewport(
     colours = np.array([[255, 0, 0], [0, 0, 255]], np.uint8)
     window.phasor_panel.preview_lines.emit(points, segments, colours)
     assert window.viewport.toolpath_segment_count() == 2
+
+
+def test_topopt_loads_and_supports_are_edited_as_json_in_the_inspector(window, qtbot):
+    nid = window.undo.push(AddNode("TopOpt", {"preset": "cantilever", "resolution": [24, 12]}, (0, 0))).node_id
+    window._on_selection_changed(nid)
+    editor = window.inspector.editors["problem"]
+    dialog = editor.open_dialog(modal=False)
+    dialog.text.setPlainText("{not json")
+    assert not dialog.try_accept()
+    assert "not valid JSON" in dialog.error.text() and dialog.isVisible()
+    # a downward unit load at the middle of the right edge, as a second load case
+    new = {"load_cases": [[{"node": [24, 6], "force": [0.0, -1.0]}], [{"node": [24, 12], "force": [0.0, -1.0]}]]}
+    dialog.text.setPlainText(json.dumps(new))
+    assert dialog.try_accept()
+    assert window.doc.node(nid).params["problem"] == new
+    window.undo.undo()
+    assert window.doc.node(nid).params["problem"] == {}
