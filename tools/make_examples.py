@@ -700,21 +700,35 @@ def write_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path,
     return written
 
 
+def _surface_examples():
+    """The Table 2/3 surface examples live in tools/surface_examples.py."""
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from surface_examples import EXAMPLES as surface_examples, write_surface_examples
+    return surface_examples, write_surface_examples
+
+
+SURFACE_EXAMPLES, write_surface_examples = _surface_examples()
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=str(EXAMPLES_DIR), help="output folder (default: resources/examples)")
     parser.add_argument("--only", nargs="+",
-                        choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES) + sorted(RD_EXAMPLES),
+                        choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES) + sorted(RD_EXAMPLES)
+                        + sorted(SURFACE_EXAMPLES),
                         help="build only these examples")
     args = parser.parse_args(argv)
     cells = [n for n in args.only or EXAMPLES if n in EXAMPLES]
     phasor = [n for n in args.only or PHASOR_EXAMPLES if n in PHASOR_EXAMPLES]
     rd = [n for n in args.only or RD_EXAMPLES if n in RD_EXAMPLES]
+    surfaces = [n for n in args.only or SURFACE_EXAMPLES if n in SURFACE_EXAMPLES]
     written = {**(write_examples(args.out, cells) if cells else {}),
                **(write_phasor_examples(args.out, phasor) if phasor else {}),
-               **(write_rd_examples(args.out, rd) if rd else {})}
+               **(write_rd_examples(args.out, rd) if rd else {}),
+               **(write_surface_examples(args.out, surfaces) if surfaces else {})}
     for path, doc in written.items():
-        paper = doc.meta["paper_node_count"]
+        paper = doc.meta.get("paper_node_count")
         print(f"{path}  ({len(doc.nodes)} nodes; paper: {paper if paper is not None else '-'})")
     return 0
 

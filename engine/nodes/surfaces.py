@@ -19,15 +19,11 @@ patch; its ``type`` picks the solver (section 5.1):
     segment slides on its FBV face whatever the chains' smoothness (the
     paper's Fig. 5c); the loop must meet the section 6.3 requirements.
 
-The fundamental bounding volume (``fbv``) is fitted to the loop: a cuboid is
-the loop's axis-aligned bounding box (an axis along which the loop is flat
-is widened by half the box's largest side both ways, so that no face holds
-the whole loop); a prism is half of that box cut along a diagonal and
-extruded along an axis, a tetrahedron a cube-corner orthoscheme of the box
-(1/6 of it) or one of its two alternate-corner tetrahedra. Of the candidates
-that hold every loop vertex the one breaking the fewest requirements of the
-surface type wins, ties in a fixed order. ``custom`` takes the half-spaces
-``n . x <= d`` of ``fbv_planes``.
+The fundamental bounding volume (``fbv``) is fitted to the loop by
+:func:`~engine.geometry.surfaces.fbv.fit_fbv` (a cuboid, half-box prism or
+tetrahedron of the loop's bounding box); of the candidates that hold every
+loop vertex the one breaking the fewest requirements of the surface type
+wins. ``custom`` takes the half-spaces ``n . x <= d`` of ``fbv_planes``.
 
 Thickness (section 5.3) comes from sparse samples: ``thickness`` holds
 ``[t, value]`` pairs with t the arc-length position along the patch boundary
@@ -40,7 +36,6 @@ over an ARAP parametrisation).
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 
@@ -49,9 +44,11 @@ import numpy as np
 from engine.geometry.surfaces.associate import BONNET_ANGLE_DEG, associate_surface
 from engine.geometry.surfaces.boundary import loop_from_chains
 from engine.geometry.surfaces.conjugate import conjugate_surface
-from engine.geometry.surfaces.curvature import surface_report
-from engine.geometry.surfaces.fbv import (FBVError, conjugate_violations, convex_volume, cuboid,
-                                          locate_points, tetrahedron, triangular_prism)
+from engine.geometry.surfaces.cscm import conjugate_surface_construction
+from engine.geometry.surfaces.curvature import face_areas, surface_report
+from engine.geometry.surfaces.dual_contour import ContourError
+from engine.geometry.surfaces.fbv import (FBV_KINDS, FBVError, FBVFitError, conjugate_violations,
+                                          fit_fbv, locate_points, sliding_planes)
 from engine.geometry.surfaces.mesh_init import boundary_loop_of
 from engine.geometry.surfaces.mixed_minimal import solve_mixed_minimal
 from engine.geometry.surfaces.plateau import solve_plateau
@@ -66,7 +63,6 @@ from engine.graph.values import Skeleton, SurfaceElement, SurfaceReport
 from .lines import order_chains
 
 SURFACE_TYPES = ("direct", "mixed_minimal", "conjugate")
-FBV_KINDS = ("cuboid", "prism", "tetrahedron", "custom")
 QUARTER_TURNS = ("+90", "-90")
 
 # Conjugate search resolution (cscm's default) and the floor of the final one.
@@ -157,85 +153,11 @@ def _join(polys, modes, planes=None):
         raise NodeInputError(f"{exc} (chains numbered in loop order)", where="chains") from None
 
 
-def _fitted_normal(points):
-    c = points - points.mean(axis=0)
-    return np.linalg.svd(c, full_matrices=False)[2][-1]
-
-
-# ------------------------------------------------------------------- FBVs
-
-def _box(points):
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    ext = hi - lo
-    flat = ext <= 1e-9 * max(float(ext.max()), 1e-12)
-    pad = 0.5 * float(ext.max())
-    return np.where(flat, lo - pad, lo), np.where(flat, hi + pad, hi)
-
-
-def _prisms(lo, hi):
-    for axis in (2, 0, 1):
-        p, q = [a for a in range(3) if a != axis]
-        rect = []
-        for bp, bq in ((0, 0), (1, 0), (1, 1), (0, 1)):
-            x = lo.copy()
-            x[p] = hi[p] if bp else lo[p]
-            x[q] = hi[q] if bq else lo[q]
-            rect.append(x)
-        sweep = np.zeros(3)
-        sweep[axis] = hi[axis] - lo[axis]
-        for drop in range(4):
-            yield triangular_prism([rect[(drop + k) % 4] for k in (1, 2, 3)], sweep)
-
-
-def _tetrahedra(lo, hi):
-    def corner(bits):
-        return np.where(np.asarray(bits, bool), hi, lo)
-
-    yield tetrahedron([corner(b) for b in ((0, 0, 0), (1, 1, 0), (1, 0, 1), (0, 1, 1))])
-    yield tetrahedron([corner(b) for b in ((1, 1, 1), (0, 0, 1), (0, 1, 0), (1, 0, 0))])
-    seen = set()
-    for start in itertools.product((0, 1), repeat=3):
-        for perm in itertools.permutations(range(3)):
-            bits, path = list(start), [tuple(start)]
-            for a in perm:
-                bits[a] = 1 - bits[a]
-                path.append(tuple(bits))
-            key = frozenset(path)
-            if key not in seen:
-                seen.add(key)
-                yield tetrahedron([corner(b) for b in path])
-
-
-def _custom(planes):
-    if len(planes) < 4:
-        raise NodeInputError(f"fbv 'custom' needs at least 4 half-spaces in fbv_planes; got {len(planes)}",
-                             where="fbv_planes")
+def _fit(kind, planes, points, score):
     try:
-        return convex_volume([p[0] for p in planes], [p[1] for p in planes])
-    except ValueError as exc:
-        raise NodeInputError(f"fbv_planes: {exc}", where="fbv_planes") from None
-
-
-def _fit_fbv(kind, planes, points, score):
-    """The FBV of ``kind`` holding ``points`` that breaks the fewest requirements."""
-    if kind == "custom":
-        return _custom(planes)
-    lo, hi = _box(points)
-    if kind == "cuboid":
-        return cuboid(lo, hi)
-    candidates = _prisms(lo, hi) if kind == "prism" else _tetrahedra(lo, hi)
-    best = None
-    for k, fbv in enumerate(candidates):
-        if not locate_points(fbv, points)[1].all():
-            continue
-        rank = (score(fbv), k)
-        if best is None or rank < best[0]:
-            best = (rank, fbv)
-    if best is None:
-        raise NodeInputError(f"no {kind} fitted to the loop's bounding box {np.round(lo, 6).tolist()} .. "
-                             f"{np.round(hi, 6).tolist()} holds every loop vertex; use cuboid or custom",
-                             where="fbv")
-    return best[1]
+        return fit_fbv(kind, points, planes=planes, score=score)
+    except FBVFitError as exc:
+        raise NodeInputError(str(exc), where=exc.parameter) from None
 
 
 def _require_inside(fbv, points, owners):
@@ -245,24 +167,6 @@ def _require_inside(fbv, points, owners):
         c, j = owners[i]
         raise NodeInputError(f"loop vertex {i} (chain {c}, vertex {j}) at {np.round(points[i], 6).tolist()} "
                              f"lies outside the {fbv.kind} FBV (rule inside)", where="chains")
-
-
-def _sliding_planes(fbv, polys, smooth, loop_points):
-    """Plane index each smooth chain slides in, or a message why it cannot."""
-    whole = frozenset.intersection(*locate_points(fbv, loop_points)[0])
-    normal = _fitted_normal(loop_points)
-    out = []
-    for c, (pts, s) in enumerate(zip(polys, smooth)):
-        if not s:
-            out.append(None)
-            continue
-        common = sorted(frozenset.intersection(*locate_points(fbv, pts)[0]) - whole)
-        if not common:
-            out.append(f"smooth chain {c} (in loop order) lies on no face of the {fbv.kind} FBV, so it "
-                       "cannot slide (rule sliding-on-face); make it straight or move it onto a face")
-            continue
-        out.append(min(common, key=lambda k: (round(abs(float(fbv.normals[k] @ normal)), 9), k)))
-    return out
 
 
 # ---------------------------------------------------------------- solvers
@@ -281,7 +185,7 @@ def _solve_direct(polys, smooth, params, ctx):
 
 
 def _solve_mixed(polys, smooth, points, fbv, params, ctx):
-    planes = _sliding_planes(fbv, polys, smooth, points)
+    planes = sliding_planes(fbv, polys, smooth, points)
     bad = [p for p in planes if isinstance(p, str)]
     if bad:
         raise NodeInputError(bad[0], where="chains")
@@ -326,9 +230,6 @@ def _conjugate_error(exc, owners):
 
 
 def _solve_conjugate(points, owners, fbv, params, ctx):
-    from engine.geometry.surfaces.cscm import conjugate_surface_construction
-    from engine.geometry.surfaces.dual_contour import ContourError
-
     perimeter = float(np.linalg.norm(np.roll(points, -1, axis=0) - points, axis=1).sum())
     pieces = max(_MIN_PIECES, int(math.ceil(perimeter / params["edge_length"])))
     try:
@@ -407,10 +308,10 @@ class SurfaceNode(NodeType):
             if kind == "conjugate":
                 return len(conjugate_violations(fbv, points)[0])
             if kind == "mixed_minimal":
-                return sum(isinstance(p, str) for p in _sliding_planes(fbv, polys, smooth, points))
+                return sum(isinstance(p, str) for p in sliding_planes(fbv, polys, smooth, points))
             return 0
 
-        fbv = _fit_fbv(params["fbv"], params["fbv_planes"], points, score)
+        fbv = _fit(params["fbv"], params["fbv_planes"], points, score)
         if kind == "conjugate":
             result = _solve_conjugate(points, owners, fbv, params, ctx)
         else:
@@ -443,10 +344,26 @@ def _surfaces_of(skeleton):
     return skeleton
 
 
-def _moved_element(element, vertices):
-    """``element`` with new vertex positions (same faces and thickness)."""
+def _area_centroid(vertices, faces):
+    """Area-weighted centroid of a triangle mesh.
+
+    Members of an associate family are placed by it: for a patch with a
+    symmetry centre (the Schwarz D hexagon, the gyroid patch) it is that
+    centre up to O(h^2), whereas the vertex centroid drifts with the mesh.
+    """
+    v, f = np.asarray(vertices), np.asarray(faces)
+    a = face_areas(v, f)
+    return (a[:, None] * v[f].mean(axis=1)).sum(axis=0) / a.sum()
+
+
+def _placed_element(element, vertices):
+    """``element`` with new vertex positions (same faces and thickness),
+    translated so that its area centroid stays on the input's."""
     v = np.asarray(vertices)
-    b = boundary_loop_of(np.asarray(element.faces), v.shape[0])
+    f = np.asarray(element.faces)
+    # at phi = 0 the member is the input bit for bit, and so is the shift zero
+    v = v + (_area_centroid(element.vertices, f) - _area_centroid(v, f))
+    b = boundary_loop_of(f, v.shape[0])
     return SurfaceElement(v, element.faces, element.thickness, v[b])
 
 
@@ -455,7 +372,7 @@ class DualSurfaceNode(NodeType):
     """The discrete conjugate of each surface patch (e.g. the dual of a conjugate Surface).
 
     The conjugate is isometric to the input and shares its normals; it is
-    placed with its vertex centroid on the input's. Line elements pass
+    placed with its area centroid on the input's. Line elements pass
     through unchanged.
     """
 
@@ -472,8 +389,7 @@ class DualSurfaceNode(NodeType):
         out = []
         for e in _surfaces_of(inputs["skeleton"]).elements:
             if isinstance(e, SurfaceElement):
-                conj = conjugate_surface(e.vertices, e.faces, sign=sign)
-                e = _moved_element(e, conj.vertices + e.vertices.mean(axis=0))
+                e = _placed_element(e, conjugate_surface(e.vertices, e.faces, sign=sign).vertices)
             out.append(e)
         return {"skeleton": Skeleton(tuple(out))}
 
@@ -484,7 +400,8 @@ class AssociateFamilyNode(NodeType):
 
     phi = 0 gives the input, 90 its conjugate; from Schwarz D the gyroid
     lies at the Bonnet angle (about 38.015 degrees) and Schwarz P at 90.
-    Members keep the input's vertex centroid; lines pass through unchanged.
+    Members keep the input's area centroid (for the D hexagon: the gyroid patch's
+    centre lands on the hexagon's); lines pass through unchanged.
     """
 
     type_name = "AssociateFamily"
@@ -505,9 +422,6 @@ class AssociateFamilyNode(NodeType):
         out = []
         for e in _surfaces_of(inputs["skeleton"]).elements:
             if isinstance(e, SurfaceElement):
-                member = associate_surface(e.vertices, e.faces, phi, sign=sign)
-                # at phi = 0 the member is the input bit for bit, and so is the shift zero
-                shift = e.vertices.mean(axis=0) - member.vertices.mean(axis=0)
-                e = _moved_element(e, member.vertices + shift)
+                e = _placed_element(e, associate_surface(e.vertices, e.faces, phi, sign=sign).vertices)
             out.append(e)
         return {"skeleton": Skeleton(tuple(out))}

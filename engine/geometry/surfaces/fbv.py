@@ -18,6 +18,14 @@ normal cannot align with the FBV edges): it is refused too.
 Violations are reported as :class:`Violation` records naming the vertex
 and the rule; :func:`check_conjugate_loop` raises :class:`FBVError`
 carrying all of them.
+
+:func:`fit_fbv` fits a primitive to a boundary loop: a cuboid is the loop's
+axis-aligned bounding box (an axis along which the loop is flat is widened
+by half the box's largest side both ways, so that no face holds the whole
+loop); a prism is half of that box cut along a diagonal and extruded along
+an axis; a tetrahedron is a cube-corner orthoscheme of the box (1/6 of it)
+or one of its two alternate-corner tetrahedra. Of the candidates that hold
+every loop vertex the one with the lowest score wins, ties in a fixed order.
 """
 
 from __future__ import annotations
@@ -28,11 +36,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BoundingVolume", "Violation", "FBVError", "LoopOnFBV",
+__all__ = ["BoundingVolume", "Violation", "FBVError", "FBVFitError", "LoopOnFBV",
            "cuboid", "triangular_prism", "tetrahedron", "convex_volume",
            "locate_points", "conjugate_violations", "sliding_violations",
            "check_conjugate_loop", "vertex_frames", "dihedral_angle",
-           "DEFAULT_TOL"]
+           "FBV_KINDS", "loop_box", "box_prisms", "box_tetrahedra", "volume_from_planes",
+           "fit_fbv", "sliding_planes", "DEFAULT_TOL"]
 
 # Distances below this fraction of the FBV diameter count as "on a plane".
 DEFAULT_TOL = 1e-7
@@ -505,3 +514,198 @@ def vertex_frames(fbv, loop):
     v_n = cross / np.linalg.norm(cross, axis=1, keepdims=True)
     v_a = np.array([dihedral_angle(a, b) for a, b in zip(n_in, n_out)])
     return v_a, v_n
+
+
+# ------------------------------------------------------------ fitting a loop
+
+FBV_KINDS = ("cuboid", "prism", "tetrahedron", "custom")
+
+
+class FBVFitError(ValueError):
+    """No FBV of the requested kind can be built for a loop.
+
+    Attributes
+    ----------
+    parameter : str
+        The input at fault: ``"fbv"`` (no primitive of that kind holds the
+        loop) or ``"fbv_planes"`` (the custom half-spaces are unusable).
+    """
+
+    def __init__(self, message, parameter):
+        self.parameter = parameter
+        super().__init__(message)
+
+
+def loop_box(points):
+    """Axis-aligned bounding box of a loop, widened along flat axes.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+        Loop vertices (model units).
+
+    Returns
+    -------
+    (lo (3,) float64, hi (3,) float64)
+        An axis along which the loop is flat is widened by half the box's
+        largest side both ways, so that no face of the box holds the whole
+        loop.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    ext = hi - lo
+    flat = ext <= 1e-9 * max(float(ext.max()), 1e-12)
+    pad = 0.5 * float(ext.max())
+    return np.where(flat, lo - pad, lo), np.where(flat, hi + pad, hi)
+
+
+def box_prisms(lo, hi):
+    """The 12 half-box prisms of a box: per axis (z, x, y) the four halves
+    cut along a diagonal of the cross-section, extruded along the axis."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    for axis in (2, 0, 1):
+        p, q = [a for a in range(3) if a != axis]
+        rect = []
+        for bp, bq in ((0, 0), (1, 0), (1, 1), (0, 1)):
+            x = lo.copy()
+            x[p] = hi[p] if bp else lo[p]
+            x[q] = hi[q] if bq else lo[q]
+            rect.append(x)
+        sweep = np.zeros(3)
+        sweep[axis] = hi[axis] - lo[axis]
+        for drop in range(4):
+            yield triangular_prism([rect[(drop + k) % 4] for k in (1, 2, 3)], sweep)
+
+
+def box_tetrahedra(lo, hi):
+    """The two alternate-corner tetrahedra of a box, then its 24 cube-corner
+    orthoschemes (paths of three edges in turn along each axis)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+
+    def corner(bits):
+        return np.where(np.asarray(bits, bool), hi, lo)
+
+    yield tetrahedron([corner(b) for b in ((0, 0, 0), (1, 1, 0), (1, 0, 1), (0, 1, 1))])
+    yield tetrahedron([corner(b) for b in ((1, 1, 1), (0, 0, 1), (0, 1, 0), (1, 0, 0))])
+    seen = set()
+    for start in itertools.product((0, 1), repeat=3):
+        for perm in itertools.permutations(range(3)):
+            bits, path = list(start), [tuple(start)]
+            for a in perm:
+                bits[a] = 1 - bits[a]
+                path.append(tuple(bits))
+            key = frozenset(path)
+            if key not in seen:
+                seen.add(key)
+                yield tetrahedron([corner(b) for b in path])
+
+
+def volume_from_planes(planes):
+    """A custom FBV from ``[[nx, ny, nz], d]`` half-spaces ``n . x <= d``.
+
+    Raises
+    ------
+    FBVFitError
+        Fewer than 4 half-spaces, or ones that bound no usable volume
+        (``parameter`` is ``"fbv_planes"``).
+    """
+    if len(planes) < 4:
+        raise FBVFitError(f"fbv 'custom' needs at least 4 half-spaces in fbv_planes; got "
+                          f"{len(planes)}", "fbv_planes")
+    try:
+        return convex_volume([p[0] for p in planes], [p[1] for p in planes])
+    except ValueError as exc:
+        raise FBVFitError(f"fbv_planes: {exc}", "fbv_planes") from None
+
+
+def fit_fbv(kind, points, *, planes=(), score=None):
+    """The FBV of ``kind`` that holds a loop and scores lowest.
+
+    Parameters
+    ----------
+    kind : {'cuboid', 'prism', 'tetrahedron', 'custom'}
+    points : (n, 3) float
+        Loop vertices (model units).
+    planes : sequence of ([nx, ny, nz], d), keyword-only
+        Half-spaces of a ``custom`` FBV.
+    score : callable, optional
+        ``score(fbv) -> number``, e.g. the count of broken requirements;
+        ties go to the earlier candidate (see :func:`box_prisms`,
+        :func:`box_tetrahedra`).
+
+    Returns
+    -------
+    BoundingVolume
+
+    Raises
+    ------
+    FBVFitError
+        No candidate holds every loop vertex, or the custom planes are
+        unusable.
+    """
+    if kind not in FBV_KINDS:
+        raise FBVFitError(f"fbv must be one of {FBV_KINDS}; got {kind!r}", "fbv")
+    if kind == "custom":
+        return volume_from_planes(planes)
+    p = np.asarray(points, dtype=np.float64)
+    lo, hi = loop_box(p)
+    if kind == "cuboid":
+        return cuboid(lo, hi)
+    candidates = box_prisms(lo, hi) if kind == "prism" else box_tetrahedra(lo, hi)
+    best = None
+    for k, fbv in enumerate(candidates):
+        if not locate_points(fbv, p)[1].all():
+            continue
+        rank = (score(fbv) if score is not None else 0, k)
+        if best is None or rank < best[0]:
+            best = (rank, fbv)
+    if best is None:
+        raise FBVFitError(f"no {kind} fitted to the loop's bounding box {np.round(lo, 6).tolist()} .. "
+                          f"{np.round(hi, 6).tolist()} holds every loop vertex; use cuboid or custom",
+                          "fbv")
+    return best[1]
+
+
+def _fitted_normal(points):
+    c = points - points.mean(axis=0)
+    return np.linalg.svd(c, full_matrices=False)[2][-1]
+
+
+def sliding_planes(fbv, polylines, smooth, loop_points):
+    """The FBV plane each smooth chain of a loop slides in.
+
+    A chain on several faces slides in the one most across the loop (the
+    face whose normal is nearest to perpendicular to the loop's fitted
+    plane); faces holding the whole loop are skipped.
+
+    Parameters
+    ----------
+    fbv : BoundingVolume
+    polylines : sequence of (k_i, 3) float
+        The loop's chains in loop order.
+    smooth : sequence of bool
+        Which chains are smooth (sliding).
+    loop_points : (n, 3) float
+        The joined loop's vertices.
+
+    Returns
+    -------
+    list
+        Per chain: ``None`` (straight), a plane index, or a message (str)
+        saying why a smooth chain cannot slide (rule ``sliding-on-face``).
+    """
+    loop_points = np.asarray(loop_points, dtype=np.float64)
+    whole = frozenset.intersection(*locate_points(fbv, loop_points)[0])
+    normal = _fitted_normal(loop_points)
+    out = []
+    for c, (pts, s) in enumerate(zip(polylines, smooth)):
+        if not s:
+            out.append(None)
+            continue
+        common = sorted(frozenset.intersection(*locate_points(fbv, pts)[0]) - whole)
+        if not common:
+            out.append(f"smooth chain {c} (in loop order) lies on no face of the {fbv.kind} FBV, so it "
+                       "cannot slide (rule sliding-on-face); make it straight or move it onto a face")
+            continue
+        out.append(min(common, key=lambda k: (round(abs(float(fbv.normals[k] @ normal)), 9), k)))
+    return out

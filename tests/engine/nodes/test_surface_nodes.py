@@ -232,6 +232,12 @@ def test_surface_mirror_group_object_gives_a_closed_solid():
     assert 0.0 < solid.volume_fraction < 0.2
 
 
+def _area_centroid(element):
+    v, f = element.vertices, element.faces
+    a = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+    return (a[:, None] * v[f].mean(axis=1)).sum(axis=0) / a.sum()
+
+
 def _patch_graph():
     doc, st = _surface_graph(_sides(D_QUAD), type="mixed_minimal", edge_length=0.05)
     for nid, ntype, params in (("d", "DualSurface", {}), ("a0", "AssociateFamily", {"phi": 0.0}),
@@ -271,10 +277,14 @@ def test_associate_family_spans_input_conjugate_and_gyroid():
     (dual,) = r.output("d").surfaces
     np.testing.assert_allclose(ninety.vertices, dual.vertices, atol=1e-12)
     (gyroid,) = r.output("ag").surfaces
-    # every member is isometric to the input and keeps its centroid
+    # every member is isometric to the input and keeps its area centroid, which
+    # for the D patch (centrally symmetric) is the centre of the cube [0, 1/4]^3
     assert surface_area(gyroid.vertices, gyroid.faces) == pytest.approx(
         surface_area(src.vertices, src.faces), rel=0.01)
-    np.testing.assert_allclose(gyroid.vertices.mean(axis=0), src.vertices.mean(axis=0), atol=1e-12)
+    np.testing.assert_allclose(_area_centroid(gyroid), _area_centroid(src), atol=1e-12)
+    np.testing.assert_allclose(_area_centroid(gyroid), [0.125] * 3, atol=1e-4)
+    # the gyroid patch is centrally symmetric too: its boundary's mean is its centre
+    np.testing.assert_allclose(gyroid.boundary.mean(axis=0), [0.125] * 3, atol=1e-4)
 
 
 def test_dual_and_associate_refuse_a_skeleton_without_surfaces():

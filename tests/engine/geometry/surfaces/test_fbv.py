@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from engine.geometry.surfaces.fbv import (FBVError, check_conjugate_loop, conjugate_violations,
-                                          convex_volume, cuboid, locate_points,
+from engine.geometry.surfaces.fbv import (FBVError, FBVFitError, check_conjugate_loop,
+                                          conjugate_violations, convex_volume, cuboid, fit_fbv,
+                                          locate_points, loop_box, sliding_planes,
                                           sliding_violations, tetrahedron, triangular_prism,
                                           vertex_frames)
 
@@ -139,3 +140,38 @@ def test_sliding_segments_must_lie_on_faces():
     found = sliding_violations(CUBE, pts, [True, False, True, False])
     assert [(v.vertex, v.rule) for v in found] == [(2, "sliding-on-face")]
     assert sliding_violations(CUBE, pts, [True, False, False, False]) == []
+
+
+def test_fitted_volumes_hold_the_loop():
+    # A flat loop: the box is widened across it, so no face holds the loop.
+    square = [[0, 0, .5], [1, 0, .5], [1, 1, .5], [0, 1, .5]]
+    lo, hi = loop_box(square)
+    assert lo.tolist() == [0, 0, 0] and hi.tolist() == [1, 1, 1]
+    assert fit_fbv("cuboid", square).is_aabb
+    # The regular tetrahedron's skew quadrilateral: its alternate-corner tetrahedron.
+    quad = np.array([[0, 0, 0], [1, 1, 0], [0, 1, 1], [1, 0, 1]], float) / 4
+    tet = fit_fbv("tetrahedron", quad)
+    assert tet.kind == "tetrahedron" and locate_points(tet, quad)[1].all()
+    assert all(len(planes) == 3 for planes in locate_points(tet, quad)[0])   # corners
+
+
+def test_fit_refusals_name_the_parameter():
+    with pytest.raises(FBVFitError, match="at least 4 half-spaces") as err:
+        fit_fbv("custom", [[0, 0, 0]], planes=[[[1, 0, 0], 1]])
+    assert err.value.parameter == "fbv_planes"
+    quad = np.array([[0, 0, 0], [1, 1, 0], [0, 1, 1], [1, 0, 1]], float) / 4
+    with pytest.raises(FBVFitError, match="holds every loop vertex") as err:
+        fit_fbv("prism", quad)
+    assert err.value.parameter == "fbv"
+
+
+def test_sliding_planes_pick_a_face_or_say_why_not():
+    square = np.array([[0, 0, .5], [1, 0, .5], [1, 1, .5], [0, 1, .5]])
+    box = fit_fbv("cuboid", square)
+    chains = [square[[0, 1]], square[[1, 2]], square[[2, 3]], square[[3, 0]]]
+    planes = sliding_planes(box, chains, [False, True, False, True], square)
+    assert planes[0] is None and planes[2] is None
+    assert sorted(box.labels[k] for k in (planes[1], planes[3])) == ["x = 0", "x = 1"]
+    across = [np.array([[0, 0, .5], [1, 1, .5]])]
+    (why,) = sliding_planes(box, across, [True], square)
+    assert "sliding-on-face" in why
