@@ -44,34 +44,22 @@ if str(ROOT) not in sys.path:
 
 from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from graph_builder import COLUMN_WIDTH, GraphBuilder as _Builder, r6, vec6  # noqa: E402
+
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 
-OBJECT_RESOLUTION = 96          # Object node grid, as in the paper's examples
-MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}   # paper section 8.2
 CENTRE = [0.5, 0.5, 0.5]
 BODY_DIAGONAL = [1.0, 1.0, 1.0]
 SPHERE_SEED = 0.0               # a zero-length line: spherically thickened, a sphere (paper 3.1)
 
-COLUMN_WIDTH = 250.0
-ROW_HEIGHT = 110.0
-
-# Output / input port names of the node types used here.
-_OUT = {"Vertex": "point", "EdgeChain": "chain", "Line": "skeleton", "Mirror": "skeleton",
-        "Transform": "skeleton", "Group": "skeleton", "Object": "solid", "CSGBoolean": "solid",
-        "Voxel": "voxels"}
-_IN = {"EdgeChain": "vertices", "Line": "chains", "Mirror": "skeleton", "Transform": "skeleton",
-       "Group": "skeletons", "Object": "skeleton", "CSGBoolean": "solids", "Voxel": "solid"}
-_SOLID_STAGE = ("Object", "CSGBoolean", "Voxel")
-
 
 def _r(x: float) -> float:
-    """Round a coordinate so the JSON stays readable (1e-6 of a cell)."""
-    v = round(float(x), 6)
-    return 0.0 if v == 0 else v
+    return r6(x)
 
 
 def _vec(p) -> list[float]:
-    return [_r(c) for c in p]
+    return vec6(p)
 
 
 def _add(p, q, s: float = 1.0) -> list[float]:
@@ -89,116 +77,16 @@ def _polar(centre, radius: float, degrees: float) -> list[float]:
     return [centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a), centre[2]]
 
 
-class GraphBuilder:
-    """Records the nodes of one example, then replays them as undoable commands.
+class GraphBuilder(_Builder):
+    """A unit-cell example: mirrors and rotations act about the cell centre."""
 
-    Each ``add_*`` method returns the node id, so graphs read like the
-    construction they describe.  Positions are assigned in `document` from
-    the stage of each node (see module docstring).
-    """
+    origin = tuple(CENTRE)
+    sep = "_"
 
     def __init__(self, name: str, *, title: str, source: str, paper_nodes: int | None,
                  description: str):
-        self.name = name
-        self.meta = {"example": name, "title": title, "source": source,
-                     "paper_node_count": paper_nodes, "description": description}
-        self._nodes: list[tuple[str, str, dict, list[str]]] = []
-
-    # -- recording --------------------------------------------------------
-    def _node(self, node_id: str, type_name: str, params: dict, inputs: list[str]) -> str:
-        if any(n[0] == node_id for n in self._nodes):
-            raise ValueError(f"{self.name}: duplicate node id {node_id!r}")
-        self._nodes.append((node_id, type_name, params, list(inputs)))
-        return node_id
-
-    def vertex(self, node_id: str, position) -> str:
-        return self._node(node_id, "Vertex", {"position": _vec(position)}, [])
-
-    def chain(self, node_id: str, vertices: list[str], *, smooth: bool = False,
-              order: list[int] | None = None, period=None) -> str:
-        params: dict = {"smooth": smooth}
-        if order is not None:
-            params["order"] = list(order)
-        if period is not None:
-            params["period"] = _vec(period)
-        return self._node(node_id, "EdgeChain", params, vertices)
-
-    def line(self, node_id: str, chains: list[str], thickness, *, samples_per_segment: int | None = None) -> str:
-        params: dict = {"thickness": [[_r(t), _r(d)] for t, d in thickness]}
-        if samples_per_segment is not None:
-            params["samples_per_segment"] = samples_per_segment
-        return self._node(node_id, "Line", params, chains)
-
-    def mirror(self, node_id: str, source: str, direction, *, origin=CENTRE, copy: bool = True) -> str:
-        return self._node(node_id, "Mirror", {"direction": _vec(direction), "origin": _vec(origin),
-                                              "do_copy": copy}, [source])
-
-    def transform(self, node_id: str, source: str, *, angle: float = 0.0, axis=(0.0, 0.0, 1.0),
-                  origin=CENTRE, translation=(0.0, 0.0, 0.0), scale: float = 1.0,
-                  copy: bool = True) -> str:
-        return self._node(node_id, "Transform", {
-            "origin": _vec(origin), "scale": float(scale), "rotation_angle": float(angle),
-            "rotation_axis": _vec(axis), "translation": _vec(translation), "do_copy": copy}, [source])
-
-    def group(self, node_id: str, sources: list[str]) -> str:
-        return self._node(node_id, "Group", {}, sources)
-
-    def object(self, node_id: str, skeleton: str, *, extrusion: str = "spherical") -> str:
-        return self._node(node_id, "Object", {"resolution": OBJECT_RESOLUTION, "extrusion": extrusion},
-                          [skeleton])
-
-    def csg(self, node_id: str, solids: list[str], operation: str) -> str:
-        return self._node(node_id, "CSGBoolean", {"operation": operation}, solids)
-
-    def voxel(self, node_id: str, solid: str) -> str:
-        return self._node(node_id, "Voxel", dict(MATERIAL), [solid])
-
-    # -- shared constructions ---------------------------------------------
-    def threefold(self, prefix: str, source: str) -> str:
-        """Copies at 0, 120 and 240 degrees about the body diagonal (x -> y -> z -> x).
-
-        Two rotations of the same input and a group: no duplicated members.
-        """
-        a = self.transform(f"{prefix}_rot120", source, angle=120.0, axis=BODY_DIAGONAL)
-        b = self.transform(f"{prefix}_rot240", source, angle=240.0, axis=BODY_DIAGONAL, copy=False)
-        return self.group(f"{prefix}_xyz", [a, b])
-
-    # -- replay -----------------------------------------------------------
-    def _columns(self) -> dict[str, int]:
-        col: dict[str, int] = {}
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name not in _SOLID_STAGE:
-                col[node_id] = 1 + max((col[i] for i in inputs), default=-1)
-        object_column = 1 + max(col.values(), default=-1)
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name == "Object":
-                col[node_id] = object_column
-            elif type_name in _SOLID_STAGE:
-                col[node_id] = 1 + max(col[i] for i in inputs)
-        return col
-
-    def positions(self) -> dict[str, tuple[float, float]]:
-        col = self._columns()
-        per_column: dict[int, list[str]] = {}
-        for node_id, *_ in self._nodes:
-            per_column.setdefault(col[node_id], []).append(node_id)
-        pos = {}
-        for c, ids in per_column.items():
-            for row, node_id in enumerate(ids):
-                pos[node_id] = (c * COLUMN_WIDTH, ROW_HEIGHT * (row - (len(ids) - 1) / 2.0))
-        return pos
-
-    def document(self) -> GraphDocument:
-        doc = GraphDocument(seed=0)
-        doc.meta = dict(self.meta)
-        stack = UndoStack(doc)
-        pos = self.positions()
-        types = {n[0]: n[1] for n in self._nodes}
-        for node_id, type_name, params, inputs in self._nodes:
-            stack.push(AddNode(type_name, params, pos[node_id], node_id=node_id))
-            for src in inputs:
-                stack.push(Connect(src, _OUT[types[src]], node_id, _IN[type_name]))
-        return doc
+        super().__init__(name, {"example": name, "title": title, "source": source,
+                                "paper_node_count": paper_nodes, "description": description})
 
 
 # =============================================================== the examples
@@ -702,8 +590,6 @@ def write_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path,
 
 def _surface_examples():
     """The Table 2/3 surface examples live in tools/surface_examples.py."""
-    import sys
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
     from surface_examples import EXAMPLES as surface_examples, write_surface_examples
     return surface_examples, write_surface_examples
 

@@ -45,13 +45,14 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project  # noqa: E402
+from engine.graph import GraphDocument, save_project  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from graph_builder import GraphBuilder, r6, vec6  # noqa: E402
 
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 PREFIX = "tpms_"
 
-OBJECT_RESOLUTION = 96
-MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}          # paper section 8.2
 SHELL = 0.04                                            # shell thickness, cell units
 ORIGIN = [0.0, 0.0, 0.0]
 DIAGONAL = [1.0, 1.0, 1.0]
@@ -68,58 +69,24 @@ GYROID_CELL = 0.787887
 # point (normal along the body diagonal) lands.
 GYROID_CENTRE = [0.125, 0.125, 0.125]
 
-_OUT = {"Vertex": "point", "EdgeChain": "chain", "Line": "skeleton", "Surface": "skeleton",
-        "DualSurface": "skeleton", "AssociateFamily": "skeleton", "Mirror": "skeleton",
-        "Transform": "skeleton", "Group": "skeleton", "Object": "solid", "CSGBoolean": "solid",
-        "Voxel": "voxels"}
-_IN = {"EdgeChain": "vertices", "Line": "chains", "Surface": "chains", "DualSurface": "skeleton",
-       "AssociateFamily": "skeleton", "Mirror": "skeleton", "Transform": "skeleton",
-       "Group": "skeletons", "Object": "skeleton", "CSGBoolean": "solids", "Voxel": "solid"}
-_SOLID_STAGE = ("Object", "CSGBoolean", "Voxel")
+_r, _vec = r6, vec6
 
 
-def _r(x) -> float:
-    """A coordinate rounded to 1e-6 of a cell, so the JSON stays readable."""
-    v = round(float(x), 6)
-    return 0.0 if v == 0 else v
+class SurfaceGraph(GraphBuilder):
+    """A shell / TPMS example: mirrors and rotations act about the origin, the
+    corner of the fundamental bounding volume."""
 
-
-def _vec(p) -> list[float]:
-    return [_r(c) for c in p]
-
-
-class SurfaceGraph:
-    """Records one example's nodes, then replays them as undoable commands.
-
-    ``add_*`` methods return the node id, so a graph reads like its
-    construction. Editor positions follow the stage of each node, left to
-    right (vertices, chains, surfaces, transforms, solids).
-    """
+    origin = tuple(ORIGIN)
+    sep = ""
 
     def __init__(self, name: str, *, title: str, source: str, table: str,
                  paper_nodes: int | None, description: str):
-        self.name = PREFIX + name
-        self.meta = {"example": self.name, "title": title, "source": source, "paper_table": table,
-                     "paper_node_count": paper_nodes, "description": description}
-        self._nodes: list[tuple[str, str, dict, list[str]]] = []
-
-    # -- recording ------------------------------------------------------
-    def _node(self, node_id: str, type_name: str, params: dict, inputs: list[str]) -> str:
-        if any(n[0] == node_id for n in self._nodes):
-            raise ValueError(f"{self.name}: duplicate node id {node_id!r}")
-        self._nodes.append((node_id, type_name, params, list(inputs)))
-        return node_id
+        full = PREFIX + name
+        super().__init__(full, {"example": full, "title": title, "source": source, "paper_table": table,
+                                "paper_node_count": paper_nodes, "description": description})
 
     def vertices(self, prefix: str, points) -> list[str]:
-        return [self._node(f"{prefix}{k}", "Vertex", {"position": _vec(p)}, [])
-                for k, p in enumerate(points)]
-
-    def chain(self, node_id: str, vertices: list[str], *, smooth: bool = False,
-              closed: bool = False) -> str:
-        params: dict = {"smooth": smooth}
-        if closed:
-            params["order"] = list(range(len(vertices))) + [0]
-        return self._node(node_id, "EdgeChain", params, vertices)
+        return [self.vertex(f"{prefix}{k}", p) for k, p in enumerate(points)]
 
     def surface(self, node_id: str, chains: list[str], kind: str, *, edge_length: float,
                 thickness: float = SHELL, **params) -> str:
@@ -127,83 +94,19 @@ class SurfaceGraph:
         p.update(params)
         return self._node(node_id, "Surface", p, chains)
 
-    def line(self, node_id: str, chains: list[str], thickness: float) -> str:
-        return self._node(node_id, "Line", {"thickness": [[0.0, _r(thickness)], [1.0, _r(thickness)]]},
-                          chains)
+    def line(self, node_id: str, chains: list[str], thickness) -> str:
+        """A strut of constant diameter ``thickness``."""
+        return super().line(node_id, chains, [[0.0, thickness], [1.0, thickness]])
 
     def associate(self, node_id: str, source: str, phi: float) -> str:
         return self._node(node_id, "AssociateFamily", {"phi": float(phi)}, [source])
 
-    def mirror(self, node_id: str, source: str, direction, *, origin=ORIGIN) -> str:
-        return self._node(node_id, "Mirror", {"direction": _vec(direction), "origin": _vec(origin),
-                                              "do_copy": True}, [source])
-
-    def transform(self, node_id: str, source: str, *, angle: float = 0.0, axis=(0.0, 0.0, 1.0),
-                  origin=ORIGIN, translation=(0.0, 0.0, 0.0), scale: float = 1.0,
-                  copy: bool = True) -> str:
-        return self._node(node_id, "Transform", {
-            "origin": _vec(origin), "scale": float(scale), "rotation_angle": float(angle),
-            "rotation_axis": _vec(axis), "translation": _vec(translation), "do_copy": copy}, [source])
-
-    def group(self, node_id: str, sources: list[str]) -> str:
-        return self._node(node_id, "Group", {}, sources)
-
-    def object(self, node_id: str, skeleton: str, *, extrusion: str = "spherical") -> str:
-        return self._node(node_id, "Object", {"resolution": OBJECT_RESOLUTION, "extrusion": extrusion},
-                          [skeleton])
-
-    def csg(self, node_id: str, solids: list[str], operation: str = "union") -> str:
-        return self._node(node_id, "CSGBoolean", {"operation": operation}, solids)
-
-    def voxel(self, node_id: str, solid: str) -> str:
-        return self._node(node_id, "Voxel", dict(MATERIAL), [solid])
-
-    # -- shared constructions -------------------------------------------
     def octant_mirrors(self, prefix: str, source: str) -> str:
         """Mirrors in x = 0, y = 0 and z = 0: a piece of [0, 1/2]^3 fills [-1/2, 1/2]^3."""
         m = source
         for axis, d in zip("xyz", ([1, 0, 0], [0, 1, 0], [0, 0, 1])):
             m = self.mirror(f"{prefix}mirror_{axis}", m, d)
         return m
-
-    def threefold(self, prefix: str, source: str) -> str:
-        """Copies at 0, 120 and 240 degrees about the body diagonal through the
-        origin (x -> y -> z -> x); two rotations of one input and a group, so
-        nothing is duplicated."""
-        a = self.transform(f"{prefix}rot120", source, angle=120.0, axis=DIAGONAL)
-        b = self.transform(f"{prefix}rot240", source, angle=240.0, axis=DIAGONAL, copy=False)
-        return self.group(f"{prefix}xyz", [a, b])
-
-    # -- replay ---------------------------------------------------------
-    def _columns(self) -> dict[str, int]:
-        col: dict[str, int] = {}
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name not in _SOLID_STAGE:
-                col[node_id] = 1 + max((col[i] for i in inputs), default=-1)
-        first_solid = 1 + max(col.values(), default=-1)
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name == "Object":
-                col[node_id] = first_solid
-            elif type_name in _SOLID_STAGE:
-                col[node_id] = 1 + max(col[i] for i in inputs)
-        return col
-
-    def document(self) -> GraphDocument:
-        doc = GraphDocument(seed=0)
-        doc.meta = dict(self.meta)
-        stack = UndoStack(doc)
-        col = self._columns()
-        rows: dict[int, list[str]] = {}
-        for node_id, *_ in self._nodes:
-            rows.setdefault(col[node_id], []).append(node_id)
-        pos = {nid: (c * COLUMN_WIDTH, ROW_HEIGHT * (k - (len(ids) - 1) / 2.0))
-               for c, ids in rows.items() for k, nid in enumerate(ids)}
-        types = {n[0]: n[1] for n in self._nodes}
-        for node_id, type_name, params, inputs in self._nodes:
-            stack.push(AddNode(type_name, params, pos[node_id], node_id=node_id))
-            for src in inputs:
-                stack.push(Connect(src, _OUT[types[src]], node_id, _IN[type_name]))
-        return doc
 
 
 # ====================================================================== FBV data
