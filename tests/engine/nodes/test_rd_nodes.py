@@ -215,8 +215,7 @@ def test_an_appended_erase_regrows_locally_and_faster():
     assert outside.sum() > 0.8 * outside.size                     # a local window ...
     assert np.array_equal(after.s[:, outside], before.s[:, outside])   # ... outside it nothing moved
     assert not np.array_equal(after.s[:, ~outside], before.s[:, ~outside])
-    assert r2.results["g"].seconds < r1.results["g"].seconds
-    assert all(n > b for n, b in zip(after.steps, before.steps))
+    assert all(b < n < 2 * b for n, b in zip(after.steps, before.steps))   # regrowth: fewer steps than a growth
     # history matters only through the edits: growing afresh with the edit gives the same bytes
     fresh = _ok(Evaluator().evaluate(doc)).output("g")
     assert fresh.s.tobytes() == after.s.tobytes()

