@@ -58,3 +58,16 @@ def test_topopt_loads_and_supports_are_edited_as_json_in_the_inspector(window, q
     assert window.doc.node(nid).params["problem"] == new
     window.undo.undo()
     assert window.doc.node(nid).params["problem"] == {}
+
+
+def test_a_tpms_example_opens_and_shows_its_shell_in_the_viewport(window, wait_eval):
+    from ui.main_window import EXAMPLES_DIR
+
+    after = window.eval_count
+    assert window.open_example(EXAMPLES_DIR / "tpms_schwarz_p.json", ask=False)
+    window.evaluate_now()
+    report = wait_eval(window, after, timeout=120000)
+    assert report.ok, report.errors
+    surfaces = [nid for nid, n in window.doc.nodes.items() if n.type_name == "Surface"]
+    assert surfaces and all(report.output(nid, "report").area > 0 for nid in surfaces)
+    assert window.viewport.mesh_point_count() > 0
