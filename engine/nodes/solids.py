@@ -52,12 +52,25 @@ class ObjectNode(NodeType):
         if lines:
             fields.append(line_sdf_grid([e.polyline for e in lines], [0.5 * e.thickness for e in lines],
                                         resolution=n, method=method, periodic=True, progress=ctx.progress))
-        for s in skel.surfaces:
-            fields.append(surface_sdf_grid(s.vertices, s.faces, s.thickness, resolution=n, method=method,
+        for verts, faces, thick in _surface_batches(skel.surfaces, method):
+            fields.append(surface_sdf_grid(verts, faces, thick, resolution=n, method=method,
                                            periodic=True, progress=ctx.progress))
         ctx.check()
         sdf = csg_reduce(fields, "union")
         return {"solid": _solid_from_sdf(sdf, params["cell_size"], ctx.progress)}
+
+
+def _surface_batches(surfaces, method):
+    """(vertices, faces, thickness) per distance-field call.  Swept spheres of
+    several meshes are the union of each mesh's, so all surfaces go in one
+    call (one pass over the grid instead of one per copy); slabs cut at each
+    mesh's own boundary are computed mesh by mesh."""
+    if method != "spherical" or len(surfaces) < 2:
+        return [(s.vertices, s.faces, s.thickness) for s in surfaces]
+    offsets = np.cumsum([0] + [len(s.vertices) for s in surfaces[:-1]])
+    return [(np.concatenate([s.vertices for s in surfaces]),
+             np.concatenate([s.faces + o for s, o in zip(surfaces, offsets)]),
+             np.concatenate([s.thickness for s in surfaces]))]
 
 
 @register

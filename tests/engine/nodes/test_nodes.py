@@ -166,3 +166,29 @@ def test_zero_length_line_is_a_sphere():
     from engine.geometry.mesh_io import mesh_summary
     s = mesh_summary(r.output("o").vertices, r.output("o").faces)
     assert s["watertight"] and s["volume"] == pytest.approx(4 / 3 * math.pi * 0.3**3, rel=0.02)
+
+
+def test_object_thickens_many_surfaces_in_one_pass_exactly_as_their_union():
+    from engine.geometry.csg import csg_reduce
+    from engine.geometry.sdf_triangles import surface_sdf_grid
+    from engine.graph.values import Skeleton, SurfaceElement
+    from engine.nodes.solids import ObjectNode
+
+    rng = np.random.default_rng(5)
+    patches = []
+    for k in range(3):
+        v = rng.uniform(0.1, 0.9, size=(4, 3))
+        patches.append(SurfaceElement(v, np.array([[0, 1, 2], [0, 2, 3]]), np.full(4, 0.04 + 0.01 * k)))
+    n = 24
+    union = csg_reduce([surface_sdf_grid(p.vertices, p.faces, p.thickness, resolution=n, method="spherical",
+                                         periodic=True) for p in patches], "union")
+
+    class _Ctx:
+        progress = None
+
+        def check(self):
+            pass
+
+    solid = ObjectNode().evaluate({"skeleton": Skeleton(tuple(patches))},
+                                  {"resolution": n, "extrusion": "spherical", "cell_size": 1.0}, _Ctx())["solid"]
+    np.testing.assert_allclose(solid.sdf, union, atol=1e-6)
