@@ -98,14 +98,14 @@ def test_sampling_and_meshing_cancel(constant_infill, constant_volume):
     progress, seen = _cancel_after(1)
     with pytest.raises(Cancelled):
         diamond_surface(constant_volume, progress=progress)
-    # progress counts nodes, never goes back, ends at the total and comes often enough
-    # for a cancel to be honoured within ~100 ms
+    # progress counts nodes, never goes back, ends at the total and comes at least
+    # once per sampled plane (so a cancel waits for one plane at most)
     calls = []
     diamond_volume(constant_infill, *SUB, voxel=0.2, engine="numpy",
-                   progress=lambda d, t: calls.append((d, t, time.perf_counter())) or True)
-    assert calls[0][:2] == (0, 21 ** 3) and calls[-1][:2] == (21 ** 3, 21 ** 3)
+                   progress=lambda d, t: calls.append((d, t)) or True)
+    assert calls[0] == (0, 21 ** 3) and calls[-1] == (21 ** 3, 21 ** 3)
     assert all(a[0] <= b[0] for a, b in zip(calls, calls[1:]))
-    assert max(b[2] - a[2] for a, b in zip(calls, calls[1:])) < 0.25   # slack for a busy machine
+    assert len(calls) >= 21
 
 
 def test_refusals_name_the_argument(constant_infill):
