@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from PySide6 import QtCore
 
+from .qt_wait import process_events_until
+
 from engine.graph import CancelToken, EvalReport, Evaluator, GraphSnapshot
 
 
@@ -126,16 +128,8 @@ class EvalWorker(QtCore.QObject):
 
     def wait_idle(self, timeout_ms: int = 30000) -> bool:
         """Process events until nothing runs or is queued; for shutdown and tests."""
-        timer = QtCore.QElapsedTimer()
-        timer.start()
-        app = QtCore.QCoreApplication.instance()
-        while self.is_busy and timer.elapsed() < timeout_ms:
-            if app is not None:
-                app.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 50)
-            thread = self._thread
-            if thread is not None:
-                thread.wait(20)
-        return not self.is_busy
+        return process_events_until(lambda: not self.is_busy, lambda: self._thread,
+                                    timeout_ms=timeout_ms, slice_ms=50)
 
     def shutdown(self, timeout_ms: int = 10000) -> None:
         """Cancel everything and join the thread (window close)."""

@@ -17,6 +17,8 @@ from typing import Any, Callable
 
 from PySide6 import QtCore
 
+from .qt_wait import process_events_until
+
 from engine.geometry.cancel import Cancelled
 from engine.phasor.preview import pattern_slice, sub_plane
 
@@ -177,16 +179,7 @@ class SliceWorker(QtCore.QObject):
 
     def wait_idle(self, timeout_ms: int = 30000) -> bool:
         """Process events until nothing runs or is queued (tests, shutdown)."""
-        timer = QtCore.QElapsedTimer()
-        timer.start()
-        app = QtCore.QCoreApplication.instance()
-        while self.is_busy and timer.elapsed() < timeout_ms:
-            if app is not None:
-                app.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 20)
-            thread = self._thread
-            if thread is not None:
-                thread.wait(10)
-        return not self.is_busy
+        return process_events_until(lambda: not self.is_busy, lambda: self._thread, timeout_ms=timeout_ms)
 
     def shutdown(self, timeout_ms: int = 10000) -> None:
         """Stop everything and join the thread (the dock is closing)."""

@@ -31,6 +31,7 @@ from PySide6 import QtCore, QtWidgets
 
 from engine.rd.growth import grow
 
+from .qt_wait import process_events_until
 from .rd_canvas import GrowthPlot
 
 
@@ -295,16 +296,7 @@ class LiveGrowthWorker(QtCore.QObject):
 
     def wait_stopped(self, timeout_ms: int = 60000) -> bool:
         """Process events until no growth runs (tests, shutdown)."""
-        timer = QtCore.QElapsedTimer()
-        timer.start()
-        app = QtCore.QCoreApplication.instance()
-        while self._thread is not None and timer.elapsed() < timeout_ms:
-            if app is not None:
-                app.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 20)
-            thread = self._thread
-            if thread is not None:
-                thread.wait(10)
-        return self._thread is None
+        return process_events_until(lambda: self._thread is None, lambda: self._thread, timeout_ms=timeout_ms)
 
     def shutdown(self, timeout_ms: int = 10000) -> None:
         """Stop the growth and join its thread without emitting anything (the dock is closing)."""
