@@ -8,7 +8,9 @@ the undo stack as a user would, laying them out left to right by stage.
 
 from __future__ import annotations
 
-from engine.graph import AddNode, Connect, GraphDocument, UndoStack
+from pathlib import Path
+
+from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project
 
 OBJECT_RESOLUTION = 96          # Object node grid, as in the paper's examples
 MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}   # paper section 8.2
@@ -147,3 +149,16 @@ class GraphBuilder:
             for src in inputs:
                 stack.push(Connect(src, _OUT[types[src]], node_id, _IN[type_name]))
         return doc
+
+
+def write_documents(builders: dict, out_dir, names=None, *, prefix: str = "") -> dict[Path, GraphDocument]:
+    """Save ``builders[name]()`` for each name (all by default) as ``<out_dir>/<prefix><name>.json``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = {}
+    for name in names or builders:
+        doc = builders[name]()
+        path = out / f"{prefix}{name}.json"
+        save_project(doc, path)
+        written[path] = doc
+    return written

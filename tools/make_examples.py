@@ -42,10 +42,10 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project  # noqa: E402
+from engine.graph import AddNode, Connect, GraphDocument, UndoStack  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from graph_builder import COLUMN_WIDTH, GraphBuilder as _Builder, r6, vec6  # noqa: E402
+from graph_builder import COLUMN_WIDTH, GraphBuilder as _Builder, r6, vec6, write_documents  # noqa: E402
 
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 
@@ -505,15 +505,7 @@ PHASOR_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
 
 def write_phasor_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
     """Build the phasor infill examples (all, or `names`) as ``<out_dir>/<name>.json``."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = {}
-    for name in names or PHASOR_EXAMPLES:
-        doc = PHASOR_EXAMPLES[name]()
-        path = out / f"{name}.json"
-        save_project(doc, path)
-        written[path] = doc
-    return written
+    return write_documents(PHASOR_EXAMPLES, out_dir, names)
 
 
 # =============================================================== reaction-diffusion examples
@@ -532,7 +524,7 @@ def rd_cantilever() -> GraphDocument:
                 "description": "A 2:1 cantilever clamped on the left and loaded at the middle of its right "
                                "edge, optimised by SIMP on 64 x 32 elements (volume fraction 0.4). Its "
                                "principal stress directions, regularised, orient one Gray-Scott growth per "
-                               "direction on a 320 x 160 grid from a seed at the middle of the part; a "
+                               "direction on a 640 x 320 grid from a seed at the middle of the part; a "
                                "painted solid region keeps the load point full. The compiled lattice is "
                                "the union of the two stripe families at iso 0.7 (paper Fig. 11)."}
     stack = UndoStack(doc)
@@ -559,15 +551,7 @@ RD_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
 
 def write_rd_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
     """Build the reaction-diffusion examples (all, or `names`) as ``<out_dir>/<name>.json``."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = {}
-    for name in names or RD_EXAMPLES:
-        doc = RD_EXAMPLES[name]()
-        path = out / f"{name}.json"
-        save_project(doc, path)
-        written[path] = doc
-    return written
+    return write_documents(RD_EXAMPLES, out_dir, names)
 
 
 def build(name: str) -> GraphDocument:
@@ -577,15 +561,7 @@ def build(name: str) -> GraphDocument:
 
 def write_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
     """Build the examples (all, or `names`) and save each as ``<out_dir>/<name>.json``."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = {}
-    for name in names or EXAMPLES:
-        doc = build(name)
-        path = out / f"{name}.json"
-        save_project(doc, path)
-        written[path] = doc
-    return written
+    return write_documents({name: (lambda n=name: build(n)) for name in EXAMPLES}, out_dir, names)
 
 
 def _surface_examples():

@@ -45,10 +45,10 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from engine.graph import GraphDocument, save_project  # noqa: E402
+from engine.graph import GraphDocument  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from graph_builder import GraphBuilder, r6, vec6  # noqa: E402
+from graph_builder import GraphBuilder, r6, vec6, write_documents  # noqa: E402
 
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 PREFIX = "tpms_"
@@ -411,15 +411,8 @@ def build(name: str) -> GraphDocument:
 
 def write_surface_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
     """Build the surface examples (all, or ``names``) as ``<out_dir>/tpms_<name>.json``."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = {}
-    for name in names or EXAMPLES:
-        doc = build(name)
-        path = out / f"{PREFIX}{name}.json"
-        save_project(doc, path)
-        written[path] = doc
-    return written
+    return write_documents({name: (lambda n=name: build(n)) for name in EXAMPLES}, out_dir, names,
+                           prefix=PREFIX)
 
 
 def main(argv=None) -> int:

@@ -11,7 +11,6 @@ and the files must be exactly what ``tools/make_examples.py`` writes.
 from __future__ import annotations
 
 import functools
-import importlib.util
 import json
 from pathlib import Path
 
@@ -19,10 +18,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from engine.graph import Evaluator, SetParam, UndoStack, load_project
+from engine.graph import load_project
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLES_DIR = ROOT / "resources" / "examples"
+from .example_files import EXAMPLES_DIR, evaluate_at, load_tool
+
 FILES = sorted(p for p in EXAMPLES_DIR.glob("*.json")
                if not p.stem.startswith(("phasor_", "rd_", "tpms_")))  # unit cells
 TEST_RESOLUTION = 48
@@ -46,21 +45,13 @@ VOLUME_FRACTION_BAND = (0.02, 0.6)
 
 
 def _load_generator():
-    spec = importlib.util.spec_from_file_location("make_examples", ROOT / "tools" / "make_examples.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("make_examples")
 
 
 @functools.lru_cache(maxsize=None)
 def _evaluated(path: Path):
     """(document, report, final solid) at the test resolution; cached per file."""
-    doc = load_project(path)
-    stack = UndoStack(doc)
-    for node_id, node in doc.nodes.items():
-        if node.type_name == "Object":
-            stack.push(SetParam(node_id, "resolution", TEST_RESOLUTION))
-    report = Evaluator().evaluate(doc)
+    doc, report = evaluate_at(path, TEST_RESOLUTION)
     voxels = [n for n, node in doc.nodes.items() if node.type_name == "Voxel"]
     solid = None
     if report.ok and len(voxels) == 1:

@@ -16,7 +16,6 @@ example is evaluated by default.
 from __future__ import annotations
 
 import functools
-import importlib.util
 import itertools
 import json
 from pathlib import Path
@@ -30,8 +29,8 @@ from scipy.spatial import cKDTree
 from engine.geometry.surfaces.curvature import surface_area
 from engine.graph import Evaluator, SetParam, UndoStack, load_project
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLES_DIR = ROOT / "resources" / "examples"
+from .example_files import EXAMPLES_DIR, evaluate_at, load_tool
+
 FILES = sorted(EXAMPLES_DIR.glob("tpms_*.json"))
 TEST_RESOLUTION = 48
 
@@ -55,21 +54,13 @@ AREA_TOL = 0.0015
 
 
 def _load_generator():
-    spec = importlib.util.spec_from_file_location("surface_examples", ROOT / "tools" / "surface_examples.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("surface_examples")
 
 
 @functools.lru_cache(maxsize=None)
 def _evaluated(path: Path):
     """(document, report) at the test Object resolution; cached per file."""
-    doc = load_project(path)
-    stack = UndoStack(doc)
-    for node_id, node in doc.nodes.items():
-        if node.type_name == "Object":
-            stack.push(SetParam(node_id, "resolution", TEST_RESOLUTION))
-    return doc, Evaluator().evaluate(doc)
+    return evaluate_at(path, TEST_RESOLUTION)
 
 
 def _final_solid(doc, report):
