@@ -37,7 +37,7 @@ from .kernels import PhasorKernels
 log = logging.getLogger(__name__)
 
 __all__ = ["PhasorInfill", "SliceResult", "sample_infill", "STATES", "ENGINES", "MIN_PIXELS_PER_PERIOD",
-           "attenuation_at_points", "check_pixel", "slice_plane", "slice_noise", "infill_slice",
+           "check_pixel", "slice_plane", "slice_noise", "infill_slice",
            "layer_positions", "print_layers", "write_print"]
 
 STATES = ("raw", "aligned", "aligned+filtered")
@@ -171,22 +171,10 @@ def slice_plane(fields: PhasorFields, axis: str, position: float, pixel: float):
                                    ((lo[u], hi[u]), (lo[v], hi[v])))
 
 
-def attenuation_at_points(attenuation, fields: PhasorFields, points) -> np.ndarray | None:
-    """A(x) (n,) at ``points`` from the fields-grid attenuation, clipped to [0, 1]:
-    the trilinear blend of values of 1 can overshoot 1 by a rounding error."""
-    from .fields import trilinear
-
-    if attenuation is None:
-        return None
-    return np.clip(trilinear(attenuation, fields.lo, fields.hi, points), 0.0, 1.0)
-
-
 def _numpy_noise(kernels, plane, *, fields, filtered, filter_scale, attenuation, progress):
     from .noise import phasor_complex, slice_points
 
     points = slice_points(plane)
-    if filtered:
-        attenuation = attenuation_at_points(attenuation, fields, points)
     g_v, g_w = phasor_complex(kernels, points, fields=fields, filtered=filtered,
                               filter_scale=filter_scale, attenuation=attenuation, progress=progress)
     return g_v.reshape(plane.shape), g_w.reshape(plane.shape)

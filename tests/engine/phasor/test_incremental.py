@@ -5,7 +5,7 @@ import pytest
 
 from engine.phasor.fields import constant_fields, trilinear
 from engine.phasor.incremental import EMPTY, affected_box, changed_cells, update_infill
-from engine.phasor.infill import attenuation_at_points, sample_infill
+from engine.phasor.infill import sample_infill
 from engine.phasor.noise import phasor_complex
 from engine.phasor.sampling import sample_kernels
 from engine.phasor.strokes import Stroke, apply_stroke
@@ -79,9 +79,9 @@ def test_slices_change_only_inside_the_changed_region(painted):
     ys, xs = np.meshgrid(np.linspace(0.05, 15.95, 80), np.linspace(0.05, 15.95, 80), indexing="ij")
     pts = np.stack([xs.ravel(), ys.ravel(), np.full(xs.size, 1.0)], axis=1)
     g0 = phasor_complex(infill.kernels, pts, fields=before, filtered=True,
-                        attenuation=attenuation_at_points(infill.attenuation, before, pts))
+                        attenuation=infill.attenuation)
     g1 = phasor_complex(out.kernels, pts, fields=after, filtered=True,
-                        attenuation=attenuation_at_points(out.attenuation, after, pts))
+                        attenuation=out.attenuation)
     differ = (g0[0] != g1[0]) | (g0[1] != g1[1])
     assert differ.any()
     inside = np.all((pts >= lo) & (pts <= hi), axis=1)
