@@ -55,6 +55,9 @@ class MeshResult:
 
 
 def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
+    """The solid's mesh tiled ``tiles`` cells per axis (copies at multiples of
+    the box, ``solid.box`` mm), with its summary; one marching-cubes pass over
+    the tiled field, so the block is watertight."""
     from engine.geometry.marching import periodic_mesh
     from engine.geometry.mesh_io import mesh_summary
 
@@ -62,11 +65,16 @@ def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
     if tiles == (1, 1, 1):
         v, f = np.asarray(solid.vertices), np.asarray(solid.faces)
     else:
-        v, f = periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size)
+        v, f = periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size,
+                             cell=solid.cell)
     s = mesh_summary(v, f)
-    s["volume_fraction"] = float(s["volume"]) / (solid.cell_size ** 3 * np.prod(tiles))
+    cell_volume = solid.cell_size ** 3 if solid.is_unit_cube else float(np.prod(solid.box))
+    s["volume_fraction"] = float(s["volume"]) / (cell_volume * np.prod(tiles))
     s["grid_volume_fraction"] = solid.volume_fraction
     s["tiles"] = list(tiles)
+    if not solid.is_unit_cube:
+        s["cell"] = list(solid.cell)
+        s["box_mm"] = solid.box.tolist()
     return MeshResult(v, f, s)
 
 

@@ -284,7 +284,8 @@ class StiffnessPanel(QtWidgets.QGroupBox):
             dropped.setStyleSheet(f"color: {DROPPED_COLOUR}; font-weight: bold;")
             dropped.setText(f"{format_number(s.dropped_fraction)} of the cell removed")
         self.values["iterations"].setText(str(s.iterations))
-        self.values["resolution"].setText(f"{s.resolution}³")
+        grid = getattr(s, "grid_shape", None)
+        self.values["resolution"].setText(f"{s.resolution}³" if grid is None else "×".join(map(str, grid)))
 
     def _set_zener_visible(self, on: bool) -> None:
         self.values["zener"].setVisible(on)

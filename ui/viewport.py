@@ -142,11 +142,13 @@ def pick_stiffness_node(doc: GraphDocument, outputs: dict, selected: str | None 
 
 
 # -- geometry helpers ------------------------------------------------------------------
-def tile_offsets(tiles: int, cell_size: float) -> np.ndarray:
-    """(tiles**3, 3) translations placing the original cell in the middle."""
+def tile_offsets(tiles: int, cell_size) -> np.ndarray:
+    """(tiles**3, 3) translations placing the original cell in the middle.
+
+    cell_size : float (a cube's edge) or (3,) the cell box's edges (``Solid.box``)."""
     r = np.arange(tiles) - (tiles - 1) // 2
     grid = np.stack(np.meshgrid(r, r, r, indexing="ij"), axis=-1).reshape(-1, 3)
-    return grid.astype(float) * cell_size
+    return grid.astype(float) * (cell_size if np.ndim(cell_size) == 0 else np.asarray(cell_size, float))
 
 
 def tiled_arrays(vertices: np.ndarray, faces: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -157,21 +159,27 @@ def tiled_arrays(vertices: np.ndarray, faces: np.ndarray, offsets: np.ndarray) -
     return v, f
 
 
-def block_bounds(tiles: int, cell_size: float) -> tuple[float, float]:
-    """(lo, hi) along every axis of the block of `tiles`**3 cells drawn by the viewport."""
+def block_bounds(tiles: int, cell_size):
+    """(lo, hi) of the block of `tiles`**3 cells drawn by the viewport: floats
+    (every axis) for a cube's edge `cell_size`, (3,) arrays for a box's edges."""
+    if np.ndim(cell_size) != 0:
+        box = np.asarray(cell_size, dtype=float)
+        lo = -box * ((tiles - 1) // 2)
+        return lo, lo + tiles * box
     lo = -cell_size * ((tiles - 1) // 2)
     return lo, lo + tiles * cell_size
 
 
-def sphere_placement(tiles: int, cell_size: float, max_radius: float) -> tuple[float, np.ndarray]:
+def sphere_placement(tiles: int, cell_size, max_radius: float) -> tuple[float, np.ndarray]:
     """(scale, centre) putting a surface of largest radius `max_radius` to the
-    right (+x) of the cell block, its largest radius `SPHERE_RADIUS` of the block edge."""
-    lo, hi = block_bounds(tiles, cell_size)
-    edge = hi - lo
+    right (+x) of the cell block, its largest radius `SPHERE_RADIUS` of the
+    block's longest edge (`cell_size`: a cube's edge or a box's three edges)."""
+    lo, hi = (np.broadcast_to(np.asarray(b, dtype=float), (3,)) for b in block_bounds(tiles, cell_size))
+    edge = float((hi - lo).max())
     radius = SPHERE_RADIUS * edge
     scale = radius / max_radius if max_radius > 0 else 1.0
     mid = 0.5 * (lo + hi)
-    return scale, np.array([hi + SPHERE_GAP * edge + radius, mid, mid])
+    return scale, np.array([hi[0] + SPHERE_GAP * edge + radius, mid[1], mid[2]])
 
 
 def polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
@@ -270,6 +278,10 @@ class Viewport(QtWidgets.QWidget):
     def cell_size(self) -> float:
         return float(self.solid.cell_size) if self.solid is not None else 1.0
 
+    def cell_box(self) -> np.ndarray:
+        """(3,) mm, the edges of one tile (the solid's box; a unit cube without a solid)."""
+        return self.solid.box if self.solid is not None else np.ones(3)
+
     # -- drawing --------------------------------------------------------------------
     def redraw(self) -> None:
         if self._closed:
@@ -292,8 +304,9 @@ class Viewport(QtWidgets.QWidget):
         self._sphere_points = 0
         self._sphere_note = ""
         c = self.cell_size()
+        box = self.cell_box()
         tileable = self.solid is None or self.solid.periodic
-        offsets = tile_offsets(self.tiles if tileable else 1, c)
+        offsets = tile_offsets(self.tiles if tileable else 1, box)
         if self.show_solid and self.solid is not None and len(self.solid.faces):
             v, f = tiled_arrays(self.solid.vertices, self.solid.faces, offsets)
             mesh = polydata(v, f)
@@ -303,9 +316,9 @@ class Viewport(QtWidgets.QWidget):
             self._shown_points = int(mesh.n_points)
         if self.show_skeleton and self.skeleton is not None:
             self._draw_skeleton(self.skeleton, c)
-        self._draw_cell_boxes(c)
+        self._draw_cell_boxes(box)
         if self.show_sphere and self.stiffness is not None:
-            self._draw_material_sphere(self.stiffness, c)
+            self._draw_material_sphere(self.stiffness, box)
         if self.toolpaths is not None:
             p.add_mesh(self.toolpaths, scalars="rgb", rgb=True, line_width=1.5, name="toolpaths")
         sphere_line = self.sphere_caption if self._sphere_points else self._sphere_note
@@ -315,7 +328,7 @@ class Viewport(QtWidgets.QWidget):
         if self.solid is None and self.skeleton is None and self.toolpaths is None:
             p.add_text("nothing to show yet: evaluate a graph with a solid or skeleton node",
                        position="lower_left", font_size=9, color="#9aa0a6", name="hint")
-        key = (self.tiles, round(c, 9), self._sphere_points > 0,
+        key = (self.tiles, tuple(np.round(box, 9)), self._sphere_points > 0,
                None if self.toolpaths is None else tuple(np.round(self.toolpaths.bounds, 3)))
         if key != self._camera_key:
             self._camera_key = key
@@ -345,12 +358,13 @@ class Viewport(QtWidgets.QWidget):
                 p.add_mesh(pv.PolyData(pts), color=POINT_COLOUR, point_size=12,
                            render_points_as_spheres=True, name="control_points")
 
-    def _draw_cell_boxes(self, c: float) -> None:
-        self.plotter.add_mesh(pv.Box(bounds=(0, c, 0, c, 0, c)), style="wireframe", color=BOX_COLOUR,
+    def _draw_cell_boxes(self, box: np.ndarray) -> None:
+        bx, by, bz = (float(v) for v in box)
+        self.plotter.add_mesh(pv.Box(bounds=(0, bx, 0, by, 0, bz)), style="wireframe", color=BOX_COLOUR,
                               line_width=1.5, name="cell_box")
         if self.tiles > 1:
-            lo, hi = -c * ((self.tiles - 1) // 2), c * (1 + (self.tiles - 1) // 2)
-            self.plotter.add_mesh(pv.Box(bounds=(lo, hi, lo, hi, lo, hi)), style="wireframe",
+            lo, hi = block_bounds(self.tiles, box)
+            self.plotter.add_mesh(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])), style="wireframe",
                                   color="#5a6068", line_width=1.0, name="tiling_box")
 
     def _sphere_mesh(self, stiffness: Stiffness) -> pv.PolyData:
@@ -364,14 +378,14 @@ class Viewport(QtWidgets.QWidget):
             self._sphere_cache = (key, mesh)
         return self._sphere_cache[1]
 
-    def _draw_material_sphere(self, stiffness: Stiffness, c: float) -> None:
+    def _draw_material_sphere(self, stiffness: Stiffness, box: np.ndarray) -> None:
         try:
             base = self._sphere_mesh(stiffness)
         except ValueError:
             self._sphere_note = "material sphere: none, C is singular (the cell is a mechanism)"
             return
         radii = np.linalg.norm(base.points, axis=1)
-        scale, centre = sphere_placement(self.tiles, c, float(radii.max()))
+        scale, centre = sphere_placement(self.tiles, box, float(radii.max()))
         mesh = base.copy()
         mesh.points = base.points * scale + centre
         curve = {"line_width": 5, "render_lines_as_tubes": True} if mesh.n_lines else {}

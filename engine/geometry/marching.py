@@ -1,7 +1,9 @@
 """Tileable meshes from periodic node-sampled fields (paper section 6.5).
 
-A field of shape (N, N, N) holds node samples ``x_i = i / N`` of one periodic
-cell (see :mod:`engine.geometry.sdf_lines`); "inside" is ``field < level``.
+A field of shape (nx, ny, nz) holds node samples ``x_i = i * Lx / nx`` (and
+likewise along y, z) of one periodic box cell (see
+:mod:`engine.geometry.sdf_lines`; the unit cube by default); "inside" is
+``field < level``.
 :func:`periodic_mesh` tiles it, appends the wrap sample so the grid reaches
 the far faces, optionally caps the solid where it meets the box, and runs
 marching cubes (scikit-image, Lewiner). Because opposite faces of the tiled
@@ -13,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .box_cell import check_cell
 from .cancel import report
 
 __all__ = ["periodic_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
@@ -35,7 +38,8 @@ def _check_level(level):
     return lv
 
 
-def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=True, progress=None):
+def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None, closed=True,
+                  progress=None):
     """Extract the (tiled) solid ``field < level`` as a triangle mesh.
 
     Parameters
@@ -47,7 +51,11 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     tiles : tuple of 3 int >= 1
         Number of cells along x, y, z.
     cell_size : float > 0
-        Edge length of one cell in model units.
+        Model units (mm) per cell unit: the unit cube's edge length.
+    cell : (3,) float, optional
+        Box edges ``(Lx, Ly, Lz)`` in cell units (default the unit cube); the
+        tile is ``cell_size * cell`` model units, node spacing
+        ``cell_size * L_i / n_i`` per axis.
     closed : bool
         Cap the solid on the faces of the tiled box so the mesh is watertight.
         If False the mesh is open where the solid meets the box.
@@ -57,7 +65,7 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     Returns
     -------
     vertices : numpy.ndarray, shape (v, 3), float64
-        Model units, inside the box ``[0, tiles * cell_size]``.
+        Model units, inside the box ``[0, tiles * cell_size * cell]``.
     faces : numpy.ndarray, shape (f, 3), int64
         Counter-clockwise seen from outside (outward normals, positive
         volume). Empty arrays if the field has no surface.
@@ -84,6 +92,7 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     cs = float(cell_size)
     if not np.isfinite(cs) or cs <= 0:
         raise ValueError(f"cell_size must be a finite length > 0; got {cell_size!r}")
+    box = np.array(check_cell(cell), dtype=np.float64)
 
     # scikit-image works in float32; do the nudging there so it survives.
     f = f.astype(np.float32)
@@ -106,8 +115,8 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, closed=Tr
     grid[inner] = f[np.ix_(*axes)]
 
     verts, faces = slab_marching_cubes(grid, float(lv32), progress)
-    spacing = cs / np.array(f.shape, dtype=np.float64)
-    extent = cs * np.array(t, dtype=np.float64)
+    spacing = cs * box / np.array(f.shape, dtype=np.float64)
+    extent = cs * box * np.array(t, dtype=np.float64)
     verts = (verts.astype(np.float64) - pad) * spacing
     faces = faces.astype(np.int64)
     if closed:
@@ -273,45 +282,57 @@ def solid_volume_fraction(field, *, level=0.0):
     return float(np.count_nonzero(f < _check_level(level)) / f.size)
 
 
-def boundary_section_match(vertices, faces, *, cell_size):
+def _distinct(points, tol):
+    """One copy of each position (positions closer than ``tol`` are one)."""
+    if points.shape[0] < 2:
+        return points.copy()
+    return points[np.unique(np.round(points / tol), axis=0, return_index=True)[1]].copy()
+
+
+def boundary_section_match(vertices, faces, *, cell_size, cell=None):
     """How far the mesh's sections on opposite cell faces are from coinciding.
 
     For each axis, the vertices (referenced by ``faces``) lying on the face
-    ``x = 0`` are compared with those on ``x = cell_size`` translated back by
-    ``cell_size``. A single-cell mesh from a periodic field tiles iff these
-    point sets coincide.
+    ``x = 0`` are compared with those on ``x = cell_size * Lx`` translated
+    back by that period. A single-cell mesh from a periodic field tiles iff
+    these point sets coincide.
 
     Parameters
     ----------
     vertices : (v, 3) float; faces : (f, 3) int
     cell_size : float > 0
-        Cell edge length in model units (the mesh spans one cell).
+        Model units per cell unit (the unit cube's edge; the mesh spans one cell).
+    cell : (3,) float, optional
+        Box edges in cell units; default the unit cube.
 
     Returns
     -------
     float
         Largest nearest-neighbour distance between the paired point sets,
         both ways, over the three axes (0.0 if no vertex touches any face);
-        ``inf`` if a pair of faces carries different numbers of vertices.
+        ``inf`` if a pair of faces carries different numbers of distinct vertex positions.
     """
     from scipy.spatial import cKDTree
 
     cs = float(cell_size)
     if not np.isfinite(cs) or cs <= 0:
         raise ValueError(f"cell_size must be a finite length > 0; got {cell_size!r}")
+    period = cs * np.array(check_cell(cell), dtype=np.float64)
     v = np.asarray(vertices, dtype=np.float64)
     used = np.unique(np.asarray(faces, dtype=np.int64).ravel())
     v = v[used] if used.size else np.zeros((0, 3))
-    tol = 1e-9 * max(1.0, cs)
     worst = 0.0
     for axis in range(3):
-        low = v[np.abs(v[:, axis]) <= tol]
-        high = v[np.abs(v[:, axis] - cs) <= tol].copy()
+        tol = 1e-9 * max(1.0, float(period[axis]))
+        # distinct positions: where two sheets of the solid touch the face at
+        # a point, marching cubes keeps one vertex per sheet there
+        low = _distinct(v[np.abs(v[:, axis]) <= tol], tol)
+        high = _distinct(v[np.abs(v[:, axis] - period[axis]) <= tol], tol)
         if low.shape[0] != high.shape[0]:
             return float("inf")
         if low.shape[0] == 0:
             continue
-        high[:, axis] -= cs
+        high[:, axis] -= period[axis]
         worst = max(worst, float(cKDTree(high).query(low)[0].max()),
                     float(cKDTree(low).query(high)[0].max()))
     return worst

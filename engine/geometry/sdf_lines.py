@@ -1,9 +1,11 @@
 """Signed distance grid of thickened line skeletons (paper sections 5.3, 6.5).
 
-Grid convention (shared by every SDF kernel here): a periodic unit cell
-sampled at the nodes ``x_i = i / N``, ``i = 0 .. N-1`` on each axis, array
-index order ``[i, j, k] = [x, y, z]``. Node ``N`` would coincide with node 0,
-so appending the first plane reproduces the values at ``x = 1`` and opposite
+Grid convention (shared by every SDF kernel here): a periodic box cell
+``[0, Lx] x [0, Ly] x [0, Lz]`` (the unit cube by default, see
+:mod:`engine.geometry.box_cell`) sampled at the nodes ``x_i = i * Lx / nx``,
+``i = 0 .. nx-1``, and likewise along y and z; array index order
+``[i, j, k] = [x, y, z]``. Node ``nx`` would coincide with node 0, so
+appending the first plane reproduces the values at ``x = Lx`` and opposite
 faces of a tile are identical by construction.
 
 Each polyline segment becomes one convex element with a closed-form SDF:
@@ -25,9 +27,9 @@ exact near the surface except where elements meet).
 
 Only grid nodes whose distance to a segment's axis could be below
 ``max radius + band`` are visited; the rest keep ``+band``. With
-``periodic=True`` node indices are unwrapped (so a segment crossing ``x = 1``
-is measured against its own unwrapped coordinates) and stored modulo N,
-which makes the field exactly periodic.
+``periodic=True`` node indices are unwrapped (so a segment crossing ``x = Lx``
+is measured against its own unwrapped coordinates) and stored modulo the
+axis' node count, which makes the field exactly periodic with the box period.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from .box_cell import check_cell, check_grid_shape, default_band
 from .cancel import run_chunked
 
 __all__ = ["line_sdf_grid", "line_sdf_reference", "METHODS"]
@@ -57,10 +60,11 @@ def check_resolution(resolution):
     return int(resolution)
 
 
-def check_band(band, n):
-    """Default band is 3 voxels; an explicit one must be finite and > 0."""
+def check_band(band, n, cell=None):
+    """Default band is 3 voxels (along the coarsest axis of a box of ``n`` nodes
+    per axis, an int or three); an explicit one must be finite and > 0."""
     if band is None:
-        return 3.0 / n
+        return 3.0 / n if cell is None else default_band(cell, n)
     b = float(band)
     if not math.isfinite(b) or b <= 0.0:
         raise ValueError(f"band must be a finite distance > 0; got {band!r}")
@@ -91,15 +95,16 @@ def _check_inputs(polylines, radii, method):
     return out
 
 
-def _is_loop(p, periodic):
+def _is_loop(p, periodic, cell=(1.0, 1.0, 1.0)):
     """A polyline whose ends coincide (modulo the lattice when periodic)."""
     gap = p[-1] - p[0]
     if periodic:
-        gap = gap - np.round(gap)
+        box = np.asarray(cell, dtype=np.float64)
+        gap = gap - box * np.round(gap / box)
     return p.shape[0] > 2 and float(np.abs(gap).max()) <= 1e-9
 
 
-def build_elements(polylines, radii, *, method, periodic):
+def build_elements(polylines, radii, *, method, periodic, cell=(1.0, 1.0, 1.0)):
     """Decompose polylines into elements.
 
     Returns
@@ -117,7 +122,7 @@ def build_elements(polylines, radii, *, method, periodic):
             if np.linalg.norm(p[i + 1] - p[i]) > 1e-12:   # a flat disc has no volume
                 rows.append((p[i], p[i + 1], r[i], r[i + 1], KIND_FRUSTUM))
         joints = [(p[i], r[i]) for i in range(1, m - 1)]
-        if _is_loop(p, periodic):
+        if _is_loop(p, periodic, cell):
             joints.append((p[0], min(r[0], r[-1])))
         rows += [(c, c, rc, rc, KIND_ROUND) for c, rc in joints]
     if not rows:
@@ -154,10 +159,19 @@ def _element_table(a, b, ra, rb, band):
     return geo
 
 
-def index_ranges(lo_xyz, hi_xyz, n):
-    """Unwrapped node index ranges [lo, hi] covering boxes given in cell units."""
-    lo = np.ceil(lo_xyz * n - 1e-9).astype(np.int64)
-    hi = np.floor(hi_xyz * n + 1e-9).astype(np.int64)
+def index_ranges(lo_xyz, hi_xyz, n, cell=None):
+    """Unwrapped node index ranges [lo, hi] covering boxes given in cell units.
+
+    n : int or (3,) nodes per axis; cell : (3,) box edges (None: the unit cube).
+    """
+    if cell is None:
+        lo = np.ceil(lo_xyz * n - 1e-9).astype(np.int64)
+        hi = np.floor(hi_xyz * n + 1e-9).astype(np.int64)
+        return lo, hi
+    n = np.asarray(n, dtype=np.int64)
+    box = np.asarray(cell, dtype=np.float64)
+    lo = np.ceil(lo_xyz * n / box - 1e-9).astype(np.int64)
+    hi = np.floor(hi_xyz * n / box + 1e-9).astype(np.int64)
     return lo, hi
 
 
@@ -208,8 +222,10 @@ def _param_window(a, dlt, x, reach, t0, t1):
 
 
 @njit(cache=True, fastmath=False, parallel=True, nogil=True)
-def _sdf_planes(field, p0, p1, a, b, geo, kind, lo, hi, n, periodic, band):
+def _sdf_planes(field, p0, p1, a, b, geo, kind, lo, hi, shape, box, periodic, band):
     nel = a.shape[0]
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    lx, ly, lz = box[0], box[1], box[2]
     for pp in prange(p1 - p0):
         p = p0 + pp
         plane = field[p]
@@ -221,9 +237,9 @@ def _sdf_planes(field, p0, p1, a, b, geo, kind, lo, hi, n, periodic, band):
             ex, ey, ez = b[e, 0] - ax, b[e, 1] - ay, b[e, 2] - az
             g = geo[e]
             # Unwrapped indices congruent to p within [ilo, ihi].
-            i = ilo + (p - ilo) % n if periodic else p
+            i = ilo + (p - ilo) % nx if periodic else p
             while i <= ihi and i >= ilo:
-                x = i / n
+                x = i * lx / nx
                 # Parameter window of points whose x is within reach, then
                 # the y (and per row z) span of that sub-segment +- reach:
                 # a box bound much tighter than the segment's bounding box
@@ -232,83 +248,104 @@ def _sdf_planes(field, p0, p1, a, b, geo, kind, lo, hi, n, periodic, band):
                 if tx0 <= tx1:
                     ylo = min(ay + tx0 * ey, ay + tx1 * ey) - reach
                     yhi = max(ay + tx0 * ey, ay + tx1 * ey) + reach
-                    jlo = int(math.ceil(ylo * n - 1e-9))
-                    jhi = int(math.floor(yhi * n + 1e-9))
+                    jlo = int(math.ceil(ylo * ny / ly - 1e-9))
+                    jhi = int(math.floor(yhi * ny / ly + 1e-9))
                     if not periodic:
-                        jlo, jhi = max(jlo, 0), min(jhi, n - 1)
+                        jlo, jhi = max(jlo, 0), min(jhi, ny - 1)
                     for j in range(jlo, jhi + 1):
-                        y = j / n
+                        y = j * ly / ny
                         t0, t1 = _param_window(ay, ey, y, reach, tx0, tx1)
                         if t0 > t1:
                             continue
                         zlo = min(az + t0 * ez, az + t1 * ez) - reach
                         zhi = max(az + t0 * ez, az + t1 * ez) + reach
-                        klo = int(math.ceil(zlo * n - 1e-9))
-                        khi = int(math.floor(zhi * n + 1e-9))
+                        klo = int(math.ceil(zlo * nz / lz - 1e-9))
+                        khi = int(math.floor(zhi * nz / lz + 1e-9))
                         if not periodic:
-                            klo, khi = max(klo, 0), min(khi, n - 1)
-                        jj = j % n
-                        kk = klo % n
+                            klo, khi = max(klo, 0), min(khi, nz - 1)
+                        jj = j % ny
+                        kk = klo % nz
                         for k in range(klo, khi + 1):
-                            v = _element_sdf(x, y, k / n, ax, ay, az, g, kind[e])
+                            v = _element_sdf(x, y, k * lz / nz, ax, ay, az, g, kind[e])
                             if v < plane[jj, kk]:
                                 plane[jj, kk] = v
                             kk += 1
-                            if kk == n:
+                            if kk == nz:
                                 kk = 0
                 if not periodic:
                     break
-                i += n
+                i += nx
 
 
 # ------------------------------------------------------------------ public API
 
+def grid_of(resolution, cell):
+    """(shape, box) of a kernel call: ``resolution`` an int (nodes along the
+    box's longest edge, see :func:`engine.geometry.box_cell.box_grid_shape`)
+    or three ints ``(nx, ny, nz)``; ``cell`` three edges or None (unit cube)."""
+    from .box_cell import box_grid_shape
+
+    box = check_cell(cell)
+    if isinstance(resolution, (tuple, list, np.ndarray)):
+        return check_grid_shape(resolution), box
+    n = check_resolution(resolution)
+    return ((n, n, n) if box == (1.0, 1.0, 1.0) else box_grid_shape(box, n)), box
+
+
 def line_sdf_grid(polylines, radii, *, resolution, method="spherical", periodic=True,
-                  band=None, progress=None):
-    """Signed distance field of thickened polylines on the periodic unit cell.
+                  band=None, progress=None, cell=None):
+    """Signed distance field of thickened polylines on the periodic box cell.
 
     Parameters
     ----------
     polylines : sequence of array_like, each shape (m_k, 3), float
-        Skeleton polylines in unit-cell coordinates (m_k >= 2). Points may lie
-        outside [0, 1); with ``periodic`` they wrap.
+        Skeleton polylines in cell units (m_k >= 2). Points may lie outside
+        the box; with ``periodic`` they wrap with the box period.
     radii : sequence of array_like, each shape (m_k,) (or a scalar), float
         Radius (half the thickness, cell units, >= 0) at each vertex; varies
         linearly along each segment.
-    resolution : int
-        N >= 2; nodes at ``i / N``, ``i = 0 .. N-1``, per axis.
+    resolution : int or (3,) int
+        N >= 2: nodes along the longest box edge (N per axis on the unit
+        cube; other edges get ``round(N * L_i / L_max)``); or the grid shape
+        ``(nx, ny, nz)``, each >= 2. Nodes at ``i * Lx / nx`` etc.
     method : {"spherical", "normal"}
         Swept spheres (round ends) or a swept circular section (flat free
         ends, spherical joints).
     periodic : bool
         Wrap elements across the cell faces (field exactly periodic). If
         False, elements are clipped to the grid, which then covers
-        ``[0, (N-1)/N]``.
+        ``[0, (nx-1) Lx / nx]`` etc.
     band : float, optional
         Distance (cell units) beyond the surface up to which values are
-        exact; farther nodes hold ``+band``. Default ``3 / N``.
+        exact; farther nodes hold ``+band``. Default 3 voxels, ``3 / N`` on
+        the unit cube (``max(3 L_i / n_i)`` on a box).
     progress : callable, optional
-        ``progress(done_planes, N) -> bool``; returning False raises
+        ``progress(done_planes, nx) -> bool``; returning False raises
         :class:`engine.geometry.Cancelled`. Consulted every ~40 ms.
+    cell : (3,) float, optional
+        Box edges ``(Lx, Ly, Lz)`` in cell units, each in (0, 100]; default
+        the unit cube.
 
     Returns
     -------
-    numpy.ndarray, shape (N, N, N), float32
+    numpy.ndarray, shape (nx, ny, nz), float32
         Signed distance in cell units, negative inside, ``[x, y, z]`` order.
     """
-    n = check_resolution(resolution)
-    band = check_band(band, n)
-    a, b, ra, rb, kind = build_elements(polylines, radii, method=method, periodic=bool(periodic))
+    shape, box = grid_of(resolution, cell)
+    band = check_band(band, shape, box)
+    a, b, ra, rb, kind = build_elements(polylines, radii, method=method, periodic=bool(periodic),
+                                        cell=box)
     geo = _element_table(a, b, ra, rb, band)
     reach = geo[:, _REACH:_REACH + 1]
-    lo, hi = index_ranges(np.minimum(a, b) - reach, np.maximum(a, b) + reach, n)
-    field = np.empty((n, n, n), dtype=np.float32)
+    lo, hi = index_ranges(np.minimum(a, b) - reach, np.maximum(a, b) + reach, shape, box)
+    field = np.empty(shape, dtype=np.float32)
     per = bool(periodic)
+    shape_arr, box_arr = np.array(shape, dtype=np.int64), np.array(box, dtype=np.float64)
 
     def work(start, stop):
-        _sdf_planes(field, start, stop, a, b, geo, kind, lo, hi, n, per, band)
+        _sdf_planes(field, start, stop, a, b, geo, kind, lo, hi, shape_arr, box_arr, per, band)
 
-    run_chunked(work, n, progress)
+    run_chunked(work, shape[0], progress)
     return field
 
 
@@ -318,17 +355,18 @@ _SPHERE_SAG = 2e-5      # max dent between neighbouring sampled spheres, cell un
 _RIM_SPACING = 3e-4     # spacing of the sampled rims; distance error <= spacing / 2
 
 
-def _grid_nodes(n):
-    x = np.arange(n) / n
-    return np.stack(np.meshgrid(x, x, x, indexing="ij"), axis=-1).reshape(-1, 3)
+def grid_nodes(shape, box):
+    """(nx*ny*nz, 3) node positions ``i * L / n``, ``[x, y, z]`` C order."""
+    axes = [np.arange(n) * float(L) / n for n, L in zip(shape, box)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
-def _offsets(nodes, centres, periodic):
+def _offsets(nodes, centres, periodic, box):
     d = nodes[:, None, :] - centres[None, :, :]
     if periodic:
-        # Nearest image of a point is exact for a cubic lattice; for circles
-        # and discs it is exact while radius + band < 0.25 (checked below).
-        d -= np.round(d)
+        # Nearest image of a point is exact for a box lattice; for circles
+        # and discs it is exact while radius + band < min(L) / 4 (checked below).
+        d -= box * np.round(d / box)
     return d
 
 
@@ -337,7 +375,7 @@ def _chunks(count, nodes):
     return [slice(s, s + step) for s in range(0, count, step)]
 
 
-def _swept_spheres(nodes, a, b, ra, rb, periodic):
+def _swept_spheres(nodes, a, b, ra, rb, periodic, box):
     """min over densely sampled spheres of (|p - c| - r)."""
     length = float(np.linalg.norm(b - a))
     rmin = max(min(ra, rb), 1e-3)
@@ -349,7 +387,7 @@ def _swept_spheres(nodes, a, b, ra, rb, periodic):
     centres, rads = a + t[:, None] * (b - a), ra + t * (rb - ra)
     best = np.full(nodes.shape[0], np.inf)
     for sl in _chunks(t.size, nodes):
-        dist = np.linalg.norm(_offsets(nodes, centres[sl], periodic), axis=2) - rads[None, sl]
+        dist = np.linalg.norm(_offsets(nodes, centres[sl], periodic, box), axis=2) - rads[None, sl]
         best = np.minimum(best, dist.min(axis=1))
     return best
 
@@ -362,31 +400,31 @@ def _circle_distance(d, axis, radius, solid):
     return np.sqrt(h * h + gap * gap)
 
 
-def _frustum_boundary_distance(nodes, a, b, ra, rb, periodic):
+def _frustum_boundary_distance(nodes, a, b, ra, rb, periodic, box):
     """Distance to the frustum surface: two cap discs plus densely sampled rims."""
     axis = (b - a) / np.linalg.norm(b - a)
-    best = np.minimum(_circle_distance(_offsets(nodes, a[None], periodic)[:, 0], axis, ra, True),
-                      _circle_distance(_offsets(nodes, b[None], periodic)[:, 0], axis, rb, True))
+    best = np.minimum(_circle_distance(_offsets(nodes, a[None], periodic, box)[:, 0], axis, ra, True),
+                      _circle_distance(_offsets(nodes, b[None], periodic, box)[:, 0], axis, rb, True))
     slant = math.hypot(float(np.linalg.norm(b - a)), rb - ra)
     t = np.linspace(0.0, 1.0, int(math.ceil(slant / _RIM_SPACING)) + 1)
     centres, rads = a + t[:, None] * (b - a), ra + t * (rb - ra)
     for sl in _chunks(t.size, nodes):
-        dist = _circle_distance(_offsets(nodes, centres[sl], periodic), axis, rads[None, sl], False)
+        dist = _circle_distance(_offsets(nodes, centres[sl], periodic, box), axis, rads[None, sl], False)
         best = np.minimum(best, dist.min(axis=1))
     return best
 
 
-def _inside_frustum(nodes, a, b, ra, rb, periodic):
+def _inside_frustum(nodes, a, b, ra, rb, periodic, box):
     """Point-in-frustum test, brute force over every lattice image that can reach the cell."""
     v = b - a
     length = float(np.linalg.norm(v))
     d = v / length
     offsets = np.zeros((1, 3))
     if periodic:
-        lo = np.floor(np.minimum(a, b) - max(ra, rb)) - 1
-        hi = np.ceil(np.maximum(a, b) + max(ra, rb)) + 1
+        lo = np.floor((np.minimum(a, b) - max(ra, rb)) / box) - 1
+        hi = np.ceil((np.maximum(a, b) + max(ra, rb)) / box) + 1
         rng = [np.arange(lo[i], hi[i] + 1) for i in range(3)]
-        offsets = np.stack(np.meshgrid(*rng, indexing="ij"), -1).reshape(-1, 3)
+        offsets = np.stack(np.meshgrid(*rng, indexing="ij"), -1).reshape(-1, 3) * box
     inside = np.zeros(nodes.shape[0], dtype=bool)
     for o in offsets:
         w = nodes + o - a
@@ -397,7 +435,7 @@ def _inside_frustum(nodes, a, b, ra, rb, periodic):
 
 
 def line_sdf_reference(polylines, radii, *, resolution, method="spherical", periodic=True,
-                       band=None):
+                       band=None, cell=None):
     """Slow, plain-numpy version of :func:`line_sdf_grid` for tests and benches.
 
     Swept spheres are densely sampled spheres. A frustum's sign comes from a
@@ -406,21 +444,25 @@ def line_sdf_reference(polylines, radii, *, resolution, method="spherical", peri
     parameters, grid, element decomposition and band as
     :func:`line_sdf_grid`; accurate to about 2e-4 cell units near the
     surface and 8e-4 deep inside swept spheres. Periodic mode requires
-    radius + band < 0.25.
+    radius + band < min(L) / 4 (0.25 on the unit cube).
     """
-    n = check_resolution(resolution)
-    band = check_band(band, n)
-    a, b, ra, rb, kind = build_elements(polylines, radii, method=method, periodic=bool(periodic))
-    if periodic and a.shape[0] and float(np.maximum(ra, rb).max()) + band >= 0.25:
-        raise ValueError(f"radii + band must stay below 0.25 for the periodic reference; "
+    shape, box = grid_of(resolution, cell)
+    band = check_band(band, shape, box)
+    a, b, ra, rb, kind = build_elements(polylines, radii, method=method, periodic=bool(periodic),
+                                        cell=box)
+    limit = 0.25 * min(box)
+    if periodic and a.shape[0] and float(np.maximum(ra, rb).max()) + band >= limit:
+        raise ValueError(f"radii + band must stay below {limit!r} for the periodic reference; "
                          f"got {float(np.maximum(ra, rb).max()) + band!r}")
-    nodes = _grid_nodes(n)
+    box_arr = np.array(box)
+    nodes = grid_nodes(shape, box)
     field = np.full(nodes.shape[0], band)
     for e in range(a.shape[0]):
         if kind[e] == KIND_ROUND:
-            val = _swept_spheres(nodes, a[e], b[e], ra[e], rb[e], periodic)
+            val = _swept_spheres(nodes, a[e], b[e], ra[e], rb[e], periodic, box_arr)
         else:
-            dist = _frustum_boundary_distance(nodes, a[e], b[e], ra[e], rb[e], periodic)
-            val = np.where(_inside_frustum(nodes, a[e], b[e], ra[e], rb[e], periodic), -dist, dist)
+            dist = _frustum_boundary_distance(nodes, a[e], b[e], ra[e], rb[e], periodic, box_arr)
+            inside = _inside_frustum(nodes, a[e], b[e], ra[e], rb[e], periodic, box_arr)
+            val = np.where(inside, -dist, dist)
         field = np.minimum(field, val)
-    return field.reshape(n, n, n).astype(np.float32)
+    return field.reshape(shape).astype(np.float32)

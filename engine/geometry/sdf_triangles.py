@@ -1,7 +1,8 @@
 """Signed distance grid of thickened triangle meshes (surface skeletons).
 
-Same grid convention as :mod:`engine.geometry.sdf_lines` (nodes at i/N on
-the periodic unit cell, ``[x, y, z]`` order, ``+band`` far away).
+Same grid convention as :mod:`engine.geometry.sdf_lines` (nodes at
+``i * L / n`` per axis on the periodic box cell, the unit cube by default,
+``[x, y, z]`` order, ``+band`` far away).
 
 * ``"spherical"``: per triangle ``|p - c| - r(c)`` with ``c`` the closest
   point of the triangle and ``r`` the barycentric interpolation of half the
@@ -29,9 +30,9 @@ import numpy as np
 from numba import njit, prange
 
 from .cancel import run_chunked
-from .sdf_lines import check_band, check_resolution, index_ranges
+from .sdf_lines import check_band, grid_nodes, grid_of, index_ranges
 
-__all__ = ["surface_sdf_grid", "boundary_flags"]
+__all__ = ["surface_sdf_grid", "surface_sdf_reference", "boundary_flags"]
 
 METHODS = ("spherical", "normal")
 
@@ -174,28 +175,30 @@ def _on_boundary(u, v, w, k_edge, k_vert):
 
 @njit(cache=True, fastmath=False, parallel=True, nogil=True)
 def _surface_planes(field, p0, p1, tris, rads, normals, ebound, vbound, tlo, thi,
-                    walls, wlo, whi, n, periodic, band, normal_mode):
+                    walls, wlo, whi, shape, box, periodic, band, normal_mode):
     ntri, nwall = tris.shape[0], walls.shape[0]
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    lx, ly, lz = box[0], box[1], box[2]
     for pp in prange(p1 - p0):
         p = p0 + pp
         plane = field[p]
         plane[:, :] = band
-        bestd = np.full((n, n), np.inf)
-        walld = np.full((n, n), np.inf)
+        bestd = np.full((ny, nz), np.inf)
+        walld = np.full((ny, nz), np.inf)
         for e in range(ntri + nwall):
             is_wall = e >= ntri
             lo, hi = (wlo[e - ntri], whi[e - ntri]) if is_wall else (tlo[e], thi[e])
             tri = walls[e - ntri] if is_wall else tris[e]
-            i = lo[0] + (p - lo[0]) % n if periodic else p
+            i = lo[0] + (p - lo[0]) % nx if periodic else p
             while lo[0] <= i <= hi[0]:
-                x = i / n
+                x = i * lx / nx
                 jlo, jhi, klo, khi = lo[1], hi[1], lo[2], hi[2]
                 if not periodic:
-                    jlo, jhi, klo, khi = max(jlo, 0), min(jhi, n - 1), max(klo, 0), min(khi, n - 1)
+                    jlo, jhi, klo, khi = max(jlo, 0), min(jhi, ny - 1), max(klo, 0), min(khi, nz - 1)
                 for j in range(jlo, jhi + 1):
-                    y, jj = j / n, j % n
+                    y, jj = j * ly / ny, j % ny
                     for k in range(klo, khi + 1):
-                        z, kk = k / n, k % n
+                        z, kk = k * lz / nz, k % nz
                         u, v, w = _closest_bary(x, y, z, tri)
                         cx = u * tri[0, 0] + v * tri[1, 0] + w * tri[2, 0]
                         cy = u * tri[0, 1] + v * tri[1, 1] + w * tri[2, 1]
@@ -221,50 +224,25 @@ def _surface_planes(field, p0, p1, tris, rads, normals, ebound, vbound, tlo, thi
                             plane[jj, kk] = min(band, d - r)
                 if not periodic:
                     break
-                i += n
+                i += nx
         if normal_mode:
-            for jj in range(n):
-                for kk in range(n):
+            for jj in range(ny):
+                for kk in range(nz):
                     if plane[jj, kk] < 0.0 and -walld[jj, kk] > plane[jj, kk]:
                         plane[jj, kk] = -walld[jj, kk]
 
 
 # ------------------------------------------------------------------ public API
 
-def surface_sdf_grid(vertices, faces, thickness_per_vertex, *, resolution, method="spherical",
-                     periodic=True, band=None, progress=None):
-    """Signed distance field of a thickened triangle mesh on the unit cell.
+def _prepare(vertices, faces, thickness_per_vertex, method):
+    """Per-triangle arrays shared by the kernel and the reference.
 
-    Parameters
-    ----------
-    vertices : array_like, shape (n, 3), float
-        Mesh vertices in unit-cell coordinates.
-    faces : array_like, shape (f, 3), int
-        Triangles as vertex indices.
-    thickness_per_vertex : array_like, shape (n,), float
-        Full thickness (cell units, >= 0) at each vertex; half of it is the
-        offset on each side of the surface.
-    resolution : int
-        N >= 2; nodes at ``i / N``.
-    method : {"spherical", "normal"}
-        Rounded swept spheres, or a slab cut flat at the surface boundary.
-    periodic : bool
-        Wrap the mesh across the cell faces (exactly periodic field).
-    band : float, optional
-        Values are exact up to this distance outside; default ``3 / N``.
-    progress : callable, optional
-        ``progress(done_planes, N) -> bool``; False raises
-        :class:`engine.geometry.Cancelled`.
-
-    Returns
-    -------
-    numpy.ndarray, shape (N, N, N), float32
-        Signed distance (cell units), negative inside, ``[x, y, z]`` order.
+    Returns tris (f, 3, 3), rads (f, 3) half thickness per corner, nrm (f, 3)
+    unit normals, ebound (f, 3) / vbound (f, 3) boundary flags of the edge
+    opposite / the vertex at each corner, walls (w, 3, 3) triangles of the
+    flat end walls ("normal" only, else empty).
     """
-    n = check_resolution(resolution)
-    band = check_band(band, n)
     v, f, t = _check_mesh(vertices, faces, thickness_per_vertex, method)
-    normal_mode = method == "normal"
     tris = v[f] if f.size else np.zeros((0, 3, 3))
     rads = 0.5 * t[f] if f.size else np.zeros((0, 3))
     nrm = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]) if f.size else np.zeros((0, 3))
@@ -274,7 +252,7 @@ def surface_sdf_grid(vertices, faces, thickness_per_vertex, *, resolution, metho
     vbound = vb[f] if f.size else np.zeros((0, 3), bool)
 
     walls = np.zeros((0, 3, 3))
-    if normal_mode and f.size:
+    if method == "normal" and f.size:
         quads = []
         for tri_id, corner in zip(*np.nonzero(ebound)):
             i, j = (corner + 1) % 3, (corner + 2) % 3
@@ -284,17 +262,161 @@ def surface_sdf_grid(vertices, faces, thickness_per_vertex, *, resolution, metho
             quads += [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
         if quads:
             walls = np.array(quads, dtype=np.float64)
+    return tris, rads, nrm, ebound, vbound, walls
 
-    reach = (rads.max(axis=1) if f.size else np.zeros(0)) + band
-    tlo, thi = index_ranges(tris.min(axis=1) - reach[:, None], tris.max(axis=1) + reach[:, None], n)
-    wreach = (rads.max() if f.size else 0.0) + band
-    wlo, whi = index_ranges(walls.min(axis=1) - wreach, walls.max(axis=1) + wreach, n)
-    field = np.empty((n, n, n), dtype=np.float32)
+
+def surface_sdf_grid(vertices, faces, thickness_per_vertex, *, resolution, method="spherical",
+                     periodic=True, band=None, progress=None, cell=None):
+    """Signed distance field of a thickened triangle mesh on the periodic box cell.
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n, 3), float
+        Mesh vertices in cell units.
+    faces : array_like, shape (f, 3), int
+        Triangles as vertex indices.
+    thickness_per_vertex : array_like, shape (n,), float
+        Full thickness (cell units, >= 0) at each vertex; half of it is the
+        offset on each side of the surface.
+    resolution : int or (3,) int
+        N >= 2 nodes along the longest box edge (N per axis on the unit
+        cube), or the grid shape ``(nx, ny, nz)``; nodes at ``i * Lx / nx`` etc.
+    method : {"spherical", "normal"}
+        Rounded swept spheres, or a slab cut flat at the surface boundary.
+    periodic : bool
+        Wrap the mesh across the cell faces with the box period (exactly
+        periodic field).
+    band : float, optional
+        Values are exact up to this distance outside; default 3 voxels
+        (``3 / N`` on the unit cube).
+    progress : callable, optional
+        ``progress(done_planes, nx) -> bool``; False raises
+        :class:`engine.geometry.Cancelled`.
+    cell : (3,) float, optional
+        Box edges ``(Lx, Ly, Lz)`` in cell units; default the unit cube.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nx, ny, nz), float32
+        Signed distance (cell units), negative inside, ``[x, y, z]`` order.
+    """
+    shape, box = grid_of(resolution, cell)
+    band = check_band(band, shape, box)
+    tris, rads, nrm, ebound, vbound, walls = _prepare(vertices, faces, thickness_per_vertex, method)
+    normal_mode = method == "normal"
+    nonempty = tris.shape[0] > 0
+    reach = (rads.max(axis=1) if nonempty else np.zeros(0)) + band
+    tlo, thi = index_ranges(tris.min(axis=1) - reach[:, None], tris.max(axis=1) + reach[:, None],
+                            shape, box)
+    wreach = (rads.max() if nonempty else 0.0) + band
+    wlo, whi = index_ranges(walls.min(axis=1) - wreach, walls.max(axis=1) + wreach, shape, box)
+    field = np.empty(shape, dtype=np.float32)
     per = bool(periodic)
+    shape_arr, box_arr = np.array(shape, dtype=np.int64), np.array(box, dtype=np.float64)
 
     def work(start, stop):
         _surface_planes(field, start, stop, tris, rads, nrm, ebound, vbound, tlo, thi,
-                        walls, wlo, whi, n, per, band, normal_mode)
+                        walls, wlo, whi, shape_arr, box_arr, per, band, normal_mode)
 
-    run_chunked(work, n, progress)
+    run_chunked(work, shape[0], progress)
     return field
+
+
+# ------------------------------------------------------- slow reference (tests)
+
+def _closest_on_segments(p, a, b):
+    """(m,) distance from points p (m, 3) to segment ab and the parameter t in [0, 1]."""
+    e = b - a
+    ee = float(e @ e)
+    t = np.zeros(p.shape[0]) if ee <= 0.0 else np.clip((p - a) @ e / ee, 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[:, None] * e), axis=1), t
+
+
+def _closest_on_triangle(p, tri):
+    """Distance from points p (m, 3) to a triangle and the barycentric
+    coordinates (m, 3) of the closest point: the foot of the perpendicular
+    when it lies inside, else the nearest point of the three edges (with
+    exact zeros off the edge's corners; a zero-area triangle is its edges)."""
+    a, b, c = tri
+    n = np.cross(b - a, c - a)
+    n2 = float(n @ n)
+    w = p - a
+    if n2 > 0.0:
+        # Barycentrics of the projection (Cramer's rule in the triangle's plane).
+        v_ = (np.cross(w, c - a) @ n) / n2
+        w_ = (np.cross(b - a, w) @ n) / n2
+        bary = np.stack([1.0 - v_ - w_, v_, w_], axis=1)
+        inside = (bary >= 0.0).all(axis=1)
+        dist = np.where(inside, np.abs(w @ n) / math.sqrt(n2), np.inf)
+    else:
+        bary, inside, dist = np.zeros((p.shape[0], 3)), np.zeros(p.shape[0], bool), np.full(p.shape[0], np.inf)
+    for k in range(3):                 # edge opposite corner k: corners i -> j
+        i, j = (k + 1) % 3, (k + 2) % 3
+        d, t = _closest_on_segments(p, tri[i], tri[j])
+        better = ~inside & (d < dist)
+        dist = np.where(better, d, dist)
+        edge_bary = np.zeros((p.shape[0], 3))
+        edge_bary[:, i], edge_bary[:, j] = 1.0 - t, t
+        bary = np.where(better[:, None], edge_bary, bary)
+    return dist, bary
+
+
+def _images(lo, hi, reach, box):
+    """(k, 3) lattice translations of a body spanning [lo, hi] that can come
+    within ``reach`` of the box."""
+    klo = np.floor((-reach - hi) / box).astype(int)
+    khi = np.ceil((box + reach - lo) / box).astype(int)
+    rng = [np.arange(klo[a], khi[a] + 1) for a in range(3)]
+    return np.stack(np.meshgrid(*rng, indexing="ij"), -1).reshape(-1, 3) * box
+
+
+def surface_sdf_reference(vertices, faces, thickness_per_vertex, *, resolution,
+                          method="spherical", periodic=True, band=None, cell=None):
+    """Slow, plain-numpy version of :func:`surface_sdf_grid` for tests.
+
+    Every triangle (and every end wall) is measured from every grid node in
+    every lattice image that can reach the box (brute force, no index
+    windows); the closest point is found by projection onto the plane or
+    onto the edges. Same parameters, grid, band and normal-mode rules as
+    :func:`surface_sdf_grid` (zero-area skeleton triangles are not
+    supported: the kernel treats slivers separately).
+    """
+    shape, box = grid_of(resolution, cell)
+    band = check_band(band, shape, box)
+    tris, rads, nrm, ebound, vbound, walls = _prepare(vertices, faces, thickness_per_vertex, method)
+    box_arr = np.array(box)
+    nodes = grid_nodes(shape, box)
+    m = nodes.shape[0]
+    field = np.full(m, band)
+    bestd = np.full(m, np.inf)
+    walld = np.full(m, np.inf)
+    zero = np.zeros((1, 3))
+
+    def images(body, reach):
+        if not periodic:
+            return zero
+        return _images(body.min(axis=0), body.max(axis=0), reach, box_arr)
+
+    for e in range(tris.shape[0]):
+        for o in images(tris[e], rads[e].max() + band):
+            d, bary = _closest_on_triangle(nodes, tris[e] + o)
+            r = bary @ rads[e]
+            if method == "spherical":
+                field = np.minimum(field, d - r)
+                continue
+            closer = d < bestd
+            bestd = np.where(closer, d, bestd)
+            nzero = (bary == 0.0).sum(axis=1)
+            edge = np.where(nzero == 1, ebound[e][np.argmin(np.abs(bary), axis=1)], False)
+            vert = np.where(nzero == 2, vbound[e][np.argmax(np.abs(bary), axis=1)], False)
+            h = np.abs((nodes - (bary @ (tris[e] + o))) @ nrm[e])
+            past = np.sqrt(np.maximum(d * d - h * h, 0.0) + np.maximum(h - r, 0.0) ** 2)
+            val = np.minimum(band, np.where(edge | vert, past, d - r))
+            field = np.where(closer, val, field)
+    wreach = (rads.max() if tris.shape[0] else 0.0) + band
+    for w in walls:
+        for o in images(w, wreach):
+            walld = np.minimum(walld, _closest_on_triangle(nodes, w + o)[0])
+    if method == "normal":
+        field = np.where((field < 0.0) & (-walld > field), -walld, field)
+    return field.reshape(shape).astype(np.float32)

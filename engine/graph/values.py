@@ -123,14 +123,17 @@ class Skeleton:
 
 @dataclass(frozen=True)
 class Solid:
-    """A tileable solid over the periodic unit cell.
+    """A tileable solid over the periodic box cell.
 
-    sdf : (N, N, N) float32 signed distance (negative inside) at nodes i/N,
-        exactly periodic, so opposite faces agree by construction.
-    vertices, faces : the single-cell mesh from marching cubes (closed).
-    cell_size : edge of the unit cell in model units (mm).
+    sdf : (nx, ny, nz) float32 signed distance (negative inside) at nodes
+        ``i * Lx / nx`` etc. (cell units), exactly periodic, so opposite
+        faces agree by construction; (N, N, N) on the unit cube.
+    vertices, faces : the single-cell mesh from marching cubes (closed), mm.
+    cell_size : model units (mm) per cell unit: the edge of the unit cube.
     periodic : False for a solid that is not a tileable cell (a preview of a
         sub-box of a part): it is shown and exported once, never tiled.
+    cell : (Lx, Ly, Lz) box edges in cell units (default the unit cube); the
+        tile measures ``cell_size * cell`` mm (:attr:`box`).
     """
 
     sdf: np.ndarray
@@ -138,15 +141,40 @@ class Solid:
     faces: np.ndarray
     cell_size: float = 1.0
     periodic: bool = True
+    cell: tuple = (1.0, 1.0, 1.0)
 
     def __post_init__(self):
         object.__setattr__(self, "sdf", _frozen(self.sdf, np.float32))
         object.__setattr__(self, "vertices", _frozen(self.vertices).reshape(-1, 3))
         object.__setattr__(self, "faces", _frozen(self.faces, np.int64).reshape(-1, 3))
+        cell = tuple(float(v) for v in self.cell)
+        if len(cell) != 3 or not all(np.isfinite(v) and v > 0 for v in cell):
+            raise ValueError(f"Solid: cell must be three box edges > 0; got {self.cell!r}")
+        object.__setattr__(self, "cell", cell)
 
     @property
     def resolution(self) -> int:
-        return int(self.sdf.shape[0])
+        """Grid nodes along the longest box edge (N of an N x N x N unit-cube grid)."""
+        return int(max(self.sdf.shape))
+
+    @property
+    def grid_shape(self) -> tuple:
+        """(nx, ny, nz) grid nodes per axis."""
+        return tuple(int(n) for n in self.sdf.shape)
+
+    @property
+    def is_unit_cube(self) -> bool:
+        return self.cell == (1.0, 1.0, 1.0)
+
+    @property
+    def box(self) -> np.ndarray:
+        """(3,) float64, the tile's edges in model units: ``cell_size * cell``."""
+        return self.cell_size * np.array(self.cell, dtype=np.float64)
+
+    @property
+    def spacing(self) -> np.ndarray:
+        """(3,) float64 node spacing in model units, ``box / grid_shape``."""
+        return self.box / np.array(self.sdf.shape, dtype=np.float64)
 
     @property
     def volume_fraction(self) -> float:
@@ -157,7 +185,8 @@ class Solid:
 class VoxelModel:
     """Occupancy voxels of a solid plus its base material (paper 6.5 Voxel node).
 
-    occupancy : (N, N, N) bool, voxel (i, j, k) covers [i, i+1)/N etc.
+    occupancy : (nx, ny, nz) bool, voxel (i, j, k) covers ``[i, i+1) * Lx / nx``
+        etc. of the solid's box (``solid.cell``); (N, N, N) on the unit cube.
     E : Young's modulus (Pa), nu : Poisson's ratio, rho : density (kg/m^3).
     """
 
@@ -185,6 +214,9 @@ class Stiffness:
     constants : engineering constants (E_x ... nu_avg, eqs. 1-8 of Liu et al.);
     symmetry : detected symmetry class; zener : Zener ratio (cubic only, else None);
     dropped_fraction : material removed as disconnected islands (fraction of the cell).
+    resolution : voxels along the longest cell edge of the solve.
+    grid_shape : (nx, ny, nz) voxels of the solve, or None (``resolution``^3).
+    cell : (Lx, Ly, Lz) box the solve covered (cell units), or None (the unit cube).
     """
 
     C: np.ndarray
@@ -198,6 +230,8 @@ class Stiffness:
     dropped_fraction: float
     iterations: int
     resolution: int
+    grid_shape: tuple | None = None
+    cell: tuple | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "C", _frozen(self.C))
@@ -215,7 +249,9 @@ class Stiffness:
         return {"C": self.C.tolist(), "density": self.density, "effective_density": self.effective_density,
                 "symmetry": self.symmetry, "zener": self.zener, "dropped_fraction": self.dropped_fraction,
                 "iterations": self.iterations, "resolution": self.resolution, "E": self.E, "nu": self.nu,
-                "rho": self.rho, **self.constants}
+                "rho": self.rho, **self.constants,
+                **({} if self.grid_shape is None else {"grid_shape": list(self.grid_shape)}),
+                **({} if self.cell is None else {"cell": list(self.cell)})}
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from engine.geometry.box_cell import box_grid_shape
 from engine.geometry.resample import resample_periodic
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
@@ -12,7 +13,7 @@ from engine.physics.elastic import engineering_constants, is_singular, symmetry_
 from engine.physics.homogenize3d import homogenize_voxels
 
 
-def stiffness_from_result(result, *, E, nu, rho, resolution) -> Stiffness:
+def stiffness_from_result(result, *, E, nu, rho, resolution, grid_shape=None, cell=None) -> Stiffness:
     """Wrap a solver result with its engineering constants.
 
     A cell that does not connect along every axis (a mechanism, e.g. one
@@ -27,13 +28,16 @@ def stiffness_from_result(result, *, E, nu, rho, resolution) -> Stiffness:
         sym = symmetry_class(C, tol=1e-3)
         zener = float(zener_ratio(C)) if sym == "cubic" else None
     return Stiffness(C, E, nu, rho, float(result.density), constants, sym, zener,
-                     float(result.dropped_fraction), int(result.iterations), int(resolution))
+                     float(result.dropped_fraction), int(result.iterations), int(resolution),
+                     None if grid_shape is None else tuple(int(n) for n in grid_shape),
+                     None if cell is None else tuple(float(v) for v in cell))
 
 
 @register
 class MaterialMatrixNode(NodeType):
     """Effective stiffness tensor C of the periodic cell by voxel homogenization
-    (trilinear hexes, periodic boundary conditions), with engineering constants."""
+    (trilinear hexes, periodic boundary conditions), with engineering constants.
+    A box cell is solved on box voxels (edges ``L_i / n_i``); C is in the box's axes."""
 
     type_name = "MaterialMatrix"
     title = "Material Matrix"
@@ -43,16 +47,27 @@ class MaterialMatrixNode(NodeType):
     outputs = (Port("stiffness", "Stiffness"),)
     params = (
         Param("resolution", "int", 64, 0, 256, unit="voxels",
-              doc="voxels per cell edge for the solve (0 = the Object grid as is); the paper used 100"),
+              doc="voxels along the longest cell edge for the solve (0 = the Object grid as is); "
+                  "the paper used 100"),
     )
 
     def evaluate(self, inputs, params, ctx):
         vox = inputs["voxels"]
+        solid = vox.solid
         n = params["resolution"]
-        if n and n != vox.occupancy.shape[0]:
-            occupancy = resample_periodic(vox.solid.sdf, n) < 0
+        box = None if solid.is_unit_cube else solid.cell
+        if box is None:
+            if n and n != vox.occupancy.shape[0]:
+                occupancy = resample_periodic(solid.sdf, n) < 0
+            else:
+                occupancy = np.asarray(vox.occupancy)
         else:
-            occupancy = np.asarray(vox.occupancy)
-        result = homogenize_voxels(occupancy.astype(np.float64), E=vox.E, nu=vox.nu, progress=ctx.progress)
+            shape = box_grid_shape(box, n) if n else vox.occupancy.shape
+            occupancy = (resample_periodic(solid.sdf, shape) < 0 if shape != vox.occupancy.shape
+                         else np.asarray(vox.occupancy))
+        result = homogenize_voxels(occupancy.astype(np.float64), E=vox.E, nu=vox.nu, progress=ctx.progress,
+                                   cell=box)
         return {"stiffness": stiffness_from_result(result, E=vox.E, nu=vox.nu, rho=vox.rho,
-                                                   resolution=occupancy.shape[0])}
+                                                   resolution=max(occupancy.shape),
+                                                   grid_shape=None if box is None else occupancy.shape,
+                                                   cell=box)}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from engine.geometry.box_cell import MAX_EDGE, box_grid_shape
 from engine.geometry.csg import csg_reduce
 from engine.geometry.marching import periodic_mesh
 from engine.geometry.sdf_lines import line_sdf_grid
@@ -14,20 +15,22 @@ from engine.graph.schema import Param, Port
 from engine.graph.values import Solid, VoxelModel
 
 
-def _solid_from_sdf(sdf: np.ndarray, cell_size: float, progress=None) -> Solid:
+def _solid_from_sdf(sdf: np.ndarray, cell_size: float, progress=None, cell=(1.0, 1.0, 1.0)) -> Solid:
     if not np.any(sdf < 0):
         raise NodeInputError("the result is empty: no grid point lies inside the solid "
                              "(thicken the skeleton or raise the resolution)")
     if np.all(sdf < 0):
         raise NodeInputError("the result fills the whole cell: nothing to mesh")
-    verts, faces = periodic_mesh(sdf, cell_size=cell_size, progress=progress)
-    return Solid(sdf, verts, faces, cell_size)
+    verts, faces = periodic_mesh(sdf, cell_size=cell_size, cell=cell, progress=progress)
+    return Solid(sdf, verts, faces, cell_size, cell=tuple(cell))
 
 
 @register
 class ObjectNode(NodeType):
-    """Thickens every skeleton element on a periodic grid over the unit cell and
-    unions them; opposite faces agree so the cell tiles; marching cubes gives the mesh."""
+    """Thickens every skeleton element on a periodic grid over the cell box
+    ``[0, Lx] x [0, Ly] x [0, Lz]`` (the unit cube by default; a box covers
+    hexagonal, tetragonal and orthorhombic cells) and unions them; opposite
+    faces agree so the cell tiles; marching cubes gives the mesh."""
 
     type_name = "Object"
     title = "Object"
@@ -36,28 +39,36 @@ class ObjectNode(NodeType):
     inputs = (Port("skeleton", "Skeleton"),)
     outputs = (Port("solid", "Solid"),)
     params = (
-        Param("resolution", "int", 96, 8, 512, unit="voxels", doc="grid points per cell edge"),
+        Param("resolution", "int", 96, 8, 512, unit="voxels",
+              doc="grid points along the longest cell edge (the other edges get proportionally fewer)"),
         Param("extrusion", "enum", "spherical", choices=("spherical", "normal"),
               doc="spherical: swept spheres (rounded); normal: offset along normals (flat ends)"),
-        Param("cell_size", "float", 1.0, 1e-3, 1e4, unit="mm", doc="edge length of the unit cell"),
+        Param("cell_size", "float", 1.0, 1e-3, 1e4, unit="mm",
+              doc="mm per cell unit (the edge length of a unit-cube cell)"),
+        Param("cell", "vec3", [1.0, 1.0, 1.0], 1e-3, MAX_EDGE, unit="cell",
+              doc="box edges (Lx, Ly, Lz) of the periodic cell; hexagonal: (1, 1.7320508, c)"),
     )
 
     def evaluate(self, inputs, params, ctx):
         skel = inputs["skeleton"]
         if not skel.elements:
             raise NodeInputError("the skeleton is empty", where="skeleton")
-        n, method = params["resolution"], params["extrusion"]
+        method = params["extrusion"]
+        # the schema keeps each edge in [1e-3, MAX_EDGE]; direct callers may leave it out
+        cell = tuple(float(v) for v in params.get("cell", (1.0, 1.0, 1.0)))
+        shape = box_grid_shape(cell, params["resolution"])
         fields = []
         lines = skel.lines
         if lines:
             fields.append(line_sdf_grid([e.polyline for e in lines], [0.5 * e.thickness for e in lines],
-                                        resolution=n, method=method, periodic=True, progress=ctx.progress))
+                                        resolution=shape, cell=cell, method=method, periodic=True,
+                                        progress=ctx.progress))
         for verts, faces, thick in _surface_batches(skel.surfaces, method):
-            fields.append(surface_sdf_grid(verts, faces, thick, resolution=n, method=method,
+            fields.append(surface_sdf_grid(verts, faces, thick, resolution=shape, cell=cell, method=method,
                                            periodic=True, progress=ctx.progress))
         ctx.check()
         sdf = csg_reduce(fields, "union")
-        return {"solid": _solid_from_sdf(sdf, params["cell_size"], ctx.progress)}
+        return {"solid": _solid_from_sdf(sdf, params["cell_size"], ctx.progress, cell)}
 
 
 def _surface_batches(surfaces, method):
@@ -89,14 +100,31 @@ class CSGBooleanNode(NodeType):
         solids = inputs["solids"]
         if len(solids) < 2:
             raise NodeInputError(f"a CSG Boolean needs at least two solids, got {len(solids)}", where="solids")
-        res = [s.resolution for s in solids]
-        if len(set(res)) != 1:
-            raise NodeInputError(f"inputs must have the same grid resolution, got {res}", where="solids")
+        _check_same(solids, "cell", "cell box (cell units)")
+        shapes = [s.grid_shape for s in solids]
+        if len(set(shapes)) != 1:
+            i = next(k for k, s in enumerate(shapes) if s != shapes[0])
+            raise NodeInputError(f"inputs must have the same grid resolution: solids[0] has a "
+                                 f"{_shape_text(shapes[0])} grid, solids[{i}] {_shape_text(shapes[i])}",
+                                 where="solids")
         sizes = [s.cell_size for s in solids]
         if len(set(sizes)) != 1:
             raise NodeInputError(f"inputs must have the same cell size, got {sizes}", where="solids")
         sdf = csg_reduce([s.sdf for s in solids], params["operation"])
-        return {"solid": _solid_from_sdf(sdf, sizes[0], ctx.progress)}
+        return {"solid": _solid_from_sdf(sdf, sizes[0], ctx.progress, solids[0].cell)}
+
+
+def _shape_text(shape) -> str:
+    return "x".join(str(n) for n in shape)
+
+
+def _check_same(solids, attr, what):
+    """Refuse inputs whose `attr` differs, naming the first and the first mismatch."""
+    values = [getattr(s, attr) for s in solids]
+    for i, v in enumerate(values):
+        if v != values[0]:
+            raise NodeInputError(f"inputs must have the same {what}: solids[0] has {attr} "
+                                 f"{list(values[0])}, solids[{i}] {list(v)}", where="solids")
 
 
 @register

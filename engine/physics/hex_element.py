@@ -4,8 +4,9 @@ Conventions shared by every homogenization kernel in this package:
 
 * Voigt notation with ENGINEERING shear strains. 3D order
   ``(xx, yy, zz, yz, xz, xy)``; 2D order ``(xx, yy, xy)``.
-* An element is the unit cube ``[0, h]^dim`` (voxel or pixel of side ``h``).
-  Its local node ``l`` sits at ``h * (b_0, b_1[, b_2])`` with ``b_a = (l >> a) & 1``,
+* An element is the cube ``[0, h]^dim`` (voxel or pixel of side ``h``), or
+  the box ``[0, h_0] x [0, h_1] (x [0, h_2])`` when ``h`` is one length per
+  axis. Its local node ``l`` sits at ``h * (b_0, b_1[, b_2])`` with ``b_a = (l >> a) & 1``,
   i.e. node 0 at the origin, node 1 one step along x, node 2 along y, node 3
   along x and y, node 4 along z, ... ("lexicographic", x fastest).
 * Element degrees of freedom are node-major: dof ``l * dim + a`` is the
@@ -75,16 +76,27 @@ def _strain_operator(grads):
     return B
 
 
+def _edges(dim, h):
+    """h as given (a float) or a (dim,) float64 array of per-axis edges."""
+    if np.ndim(h) == 0:
+        return float(h)
+    edges = np.asarray(h, dtype=np.float64).reshape(-1)
+    if edges.shape != (dim,) or not np.all(np.isfinite(edges) & (edges > 0)):
+        raise ValueError(f"h must be a length > 0 or {dim} of them; got {h!r}")
+    return edges
+
+
 def element_matrices(D, dim, h=1.0):
-    """Stiffness and unit-strain loads of a cubic element of side ``h``.
+    """Stiffness and unit-strain loads of a cubic (or box) element.
 
     Parameters
     ----------
     D : (n_voigt, n_voigt) float64
         Constitutive matrix (engineering shear), n_voigt = 6 (3D) or 3 (2D).
     dim : {2, 3}
-    h : float
-        Element side length.
+    h : float or (dim,) float
+        Element side length, or the edge lengths ``(h_x, h_y[, h_z])`` of a
+        box element.
 
     Returns
     -------
@@ -99,10 +111,15 @@ def element_matrices(D, dim, h=1.0):
     nde = 2 ** dim * dim
     K = np.zeros((nde, nde))
     F = np.zeros((nde, D.shape[0]))
-    weight = h ** dim / 2 ** dim
+    h = _edges(dim, h)
+    box = np.ndim(h) == 1
+    weight = (float(np.prod(h)) if box else h ** dim) / 2 ** dim
     for idx in np.ndindex(*([2] * dim)):
         xi = gauss[list(idx)]
-        B = _strain_operator(_shape_gradients(dim, xi)) / h
+        if box:   # chain rule per axis: d/dx_a = (1 / h_a) d/dxi_a
+            B = _strain_operator(_shape_gradients(dim, xi) / h[None, :])
+        else:
+            B = _strain_operator(_shape_gradients(dim, xi)) / h
         K += weight * B.T @ D @ B
         F += weight * B.T @ D
     # Exact symmetry (the sum above is symmetric up to rounding only).
@@ -113,12 +130,14 @@ def element_matrices(D, dim, h=1.0):
 def unit_strain_displacements(dim, h=1.0):
     """Nodal displacements ``u = eps x`` of the unit macroscopic strains.
 
+    h : float or (dim,) float, element side or box edges.
+
     Returns
     -------
     U0 : (2**dim * dim, n_voigt) float64; column ``i`` belongs to the unit
         Voigt strain ``i`` (engineering shear 1 = tensor shear 1/2).
     """
-    x = h * _local_nodes(dim).astype(np.float64)
+    x = _edges(dim, h) * _local_nodes(dim).astype(np.float64)
     if dim == 3:
         comps = [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)]
     else:

@@ -8,21 +8,24 @@ stiffness follows from the cell-averaged strain energy (:mod:`periodic_fe`).
 
 from __future__ import annotations
 
+import numpy as np
+
 from .periodic_fe import HomogenizationResult, check_common, check_density, homogenize_grid
 
 __all__ = ["homogenize_voxels", "HomogenizationResult"]
 
 
 def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
-                      max_iterations=1000, progress=None, threads=None, memory_limit=None):
+                      max_iterations=1000, progress=None, threads=None, memory_limit=None,
+                      cell=None):
     """Effective elastic stiffness of a periodic voxel cell.
 
     Parameters
     ----------
-    density : (n, n, n) array of float or bool in [0, 1]
+    density : (n, n, n) or, with ``cell``, (nx, ny, nz) array of float or bool in [0, 1]
         Material per voxel, index ``[i, j, k] = [x, y, z]``; the cell is the
         unit cube with voxels of side ``1/n`` (a CUBIC grid is required,
-        ``nx == ny == nz``). A voxel of density ``rho`` has Young's modulus
+        ``nx == ny == nz``, unless ``cell`` is given). A voxel of density ``rho`` has Young's modulus
         ``rho * E`` and Poisson ratio ``nu`` (linear, SIMP exponent 1), so a
         binary array is a solid/void cell and two values give two materials.
     E : float > 0
@@ -55,6 +58,10 @@ def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
     memory_limit : float or None
         Refuse (MemoryError, with the estimate) a grid whose estimated peak
         memory exceeds this many bytes; default 80 % of the available memory.
+    cell : (3,) float or None
+        Box cell ``(Lx, Ly, Lz)`` (any unit, only ratios matter): the grid
+        covers the box with box voxels of edges ``L_i / n_i`` (trilinear hexes
+        of those edges). None: the unit cube, cubic grid.
 
     Returns
     -------
@@ -76,9 +83,18 @@ def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
     E, nu, vm, tol = check_common(E, nu, void_modulus, tol, max_iterations, threads,
                                   memory_limit)
     arr = check_density(density, "density", 3)
-    if not arr.shape[0] == arr.shape[1] == arr.shape[2]:
-        raise ValueError(f"density must be a cubic grid (nx == ny == nz) for a cubic "
-                         f"cell; got shape {arr.shape}")
+    voxel_size = None
+    if cell is None:
+        if not arr.shape[0] == arr.shape[1] == arr.shape[2]:
+            raise ValueError(f"density must be a cubic grid (nx == ny == nz) for a cubic "
+                             f"cell; got shape {arr.shape}")
+    else:
+        box = np.asarray(cell, dtype=np.float64).reshape(-1)
+        if box.shape != (3,) or not np.all(np.isfinite(box) & (box > 0)):
+            raise ValueError(f"cell must be three box edges > 0; got {cell!r}")
+        h = box / np.array(arr.shape, dtype=np.float64)
+        if not np.all(h == h[0]):
+            voxel_size = h / h.max()
     return homogenize_grid(arr, E=E, nu=nu, void_modulus=vm, tol=tol,
                            max_iterations=int(max_iterations), progress=progress,
-                           threads=threads, memory_limit=memory_limit)
+                           threads=threads, memory_limit=memory_limit, voxel_size=voxel_size)

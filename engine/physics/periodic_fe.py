@@ -221,8 +221,12 @@ class _Ticker:
 
 
 def homogenize_grid(density, *, E, nu, void_modulus, tol, max_iterations, progress,
-                    threads, memory_limit, shape_out=None):
-    """Homogenize a validated density grid (axis a = direction a). See fronts."""
+                    threads, memory_limit, shape_out=None, voxel_size=None):
+    """Homogenize a validated density grid (axis a = direction a). See fronts.
+
+    voxel_size : None (cubic voxels) or (dim,) float edge lengths of a box
+        voxel (any common scale: only their ratios matter).
+    """
     t_start = time.perf_counter()
     dim = density.ndim
     need = estimate_memory(density, void_modulus)
@@ -246,7 +250,7 @@ def homogenize_grid(density, *, E, nu, void_modulus, tol, max_iterations, progre
     numba.set_num_threads(int(threads))
     try:
         return _solve(density, dim, E, nu, void_modulus, tol, max_iterations, ticker,
-                      t_start, shape_out, _ThreadChooser(choose))
+                      t_start, shape_out, _ThreadChooser(choose), voxel_size)
     finally:
         numba.set_num_threads(old)
 
@@ -294,12 +298,15 @@ def _limit_from_machine():
 
 
 def _solve(density, dim, E, nu, vm, tol, max_iterations, ticker, t_start, shape_out,
-           chooser):
+           chooser, voxel_size=None):
     nv = 6 if dim == 3 else 3
     D_of = isotropic_stiffness if dim == 3 else plane_stress_stiffness
     # Groups: 0 = base material (nu), 1 = soft void (nu = 0); internal E = 1.
     Ds = [D_of(1.0, nu), D_of(1.0, 0.0)]
-    mats = [element_matrices(D, dim) for D in Ds]
+    if voxel_size is None:
+        mats = [element_matrices(D, dim) for D in Ds]
+    else:
+        mats = [element_matrices(D, dim, voxel_size) for D in Ds]
     K0 = np.array([m[0] for m in mats])
     Fe = np.array([m[1] for m in mats])
 
@@ -364,7 +371,11 @@ def _solve(density, dim, E, nu, vm, tol, max_iterations, ticker, t_start, shape_
                            f"(estimated error {sol.errors.max():.2e} > tol {tol:.1e})")
 
     FU = F.T @ U
-    C = (A0 - FU - FU.T + U.T @ KU) / density.size
+    if voxel_size is None:
+        C = (A0 - FU - FU.T + U.T @ KU) / density.size
+    else:   # A0 counted unit volumes per element; a box voxel has prod(h)
+        vol = float(np.prod(voxel_size))
+        C = (A0 * vol - FU - FU.T + U.T @ KU) / (density.size * vol)
     C = 0.5 * (C + C.T) * E
     C.setflags(write=False)
     ticker.done = PROGRESS_TOTAL
