@@ -96,9 +96,12 @@ class GraphBuilder:
     def group(self, node_id: str, sources: list[str]) -> str:
         return self._node(node_id, "Group", {}, sources)
 
-    def object(self, node_id: str, skeleton: str, *, extrusion: str = "spherical") -> str:
-        return self._node(node_id, "Object", {"resolution": OBJECT_RESOLUTION, "extrusion": extrusion},
-                          [skeleton])
+    def object(self, node_id: str, skeleton: str, *, extrusion: str = "spherical", cell=None) -> str:
+        """``cell``: the box edge lengths of a non-cubic periodic cell (default the unit cube)."""
+        params = {"resolution": OBJECT_RESOLUTION, "extrusion": extrusion}
+        if cell is not None:
+            params["cell"] = vec6(cell)
+        return self._node(node_id, "Object", params, [skeleton])
 
     def csg(self, node_id: str, solids: list[str], operation: str = "union") -> str:
         return self._node(node_id, "CSGBoolean", {"operation": operation}, solids)

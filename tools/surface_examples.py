@@ -15,12 +15,17 @@ published; the Table 3 entries are hybrids whose figures are not part of
 the paper's text, so their graphs are our reading of the name and the node
 statistics of Table 4 (each description says what was chosen).
 
-Not built: Schoen S'-S'' and its deformation, Steffmann, Schwarz CLP,
-Schoen R2, Hao Chen's aD/tD and the deformed H. Their fundamental patches
-(vertex positions, smooth flags, FBV) are given only in the paper's Table 2
-figure, which its text does not carry. Of the 7-vertex conjugate loops a
-cube FBV admits, only Wei's converges (the other three types stop at contour
-energies 1e-2 to 4e-2), so S'-S'' needs an FBV we could not identify.
+Schwarz CLP and Schwarz H are built from their classical constructions (a
+Plateau hexagon of straight lines; a mixed minimal piece of the annulus
+between two triangles, on the hexagonal lattice's orthorhombic cell); Table
+2's "Deformed H" row is represented by that H family member.
+
+Not built: Schoen S'-S'' and its deformation, Steffmann, Schoen R2 and Hao
+Chen's aD/tD. Their fundamental patches (vertex positions, smooth flags, FBV)
+are given only in the paper's Table 2 figure, which its text does not carry.
+Of the 7-vertex conjugate loops a cube FBV admits, only Wei's converges (the
+other three types stop at contour energies 1e-2 to 4e-2), so S'-S'' needs an
+FBV we could not identify.
 
 Usage::
 
@@ -134,8 +139,8 @@ def _closed_surface(g: SurfaceGraph, prefix: str, points, kind: str, **surface) 
     return g.surface(f"s_{prefix}", [chain], kind, **surface)
 
 
-def _finish(g: SurfaceGraph, skeleton: str, *, extrusion: str = "spherical") -> SurfaceGraph:
-    g.voxel("voxel", g.object("object", skeleton, extrusion=extrusion))
+def _finish(g: SurfaceGraph, skeleton: str, *, extrusion: str = "spherical", cell=None) -> SurfaceGraph:
+    g.voxel("voxel", g.object("object", skeleton, extrusion=extrusion, cell=cell))
     return g
 
 
@@ -220,6 +225,80 @@ def wei_genus4() -> SurfaceGraph:
                                         [.5, .25, 0], [.5, .5, .25], [.25, .5, .5]],
                         "conjugate", edge_length=0.025, max_iter=200)
     return _finish(g, g.octant_mirrors("", s))
+
+
+# Schwarz CLP: half of the Plateau octagon over the square [0, 1/2]^2 whose
+# bottom edges (z = 0) run along x on y = 0 and y = 1/2, whose top edges
+# (z = 1/2) run along y on x = 0 and x = 1/2, joined by vertical edges at the
+# corners.  The octagon's solution is a graph f(x, y) with f(x, y) + f(y, x) =
+# 1/2 (its half-turn about the diagonal x = y, z = 1/4 maps it to itself), so
+# that diagonal lies on the surface and cuts it into two hexagons with six
+# right angles each (Gauss-Bonnet: -pi per patch, 8 patches: genus 3).
+CLP_HEXAGON = [[0, 0, .25], [0, 0, 0], [.5, 0, 0], [.5, 0, .5], [.5, .5, .5], [.5, .5, .25]]
+
+
+def schwarz_clp() -> SurfaceGraph:
+    g = SurfaceGraph(
+        "schwarz_clp", title="Schwarz CLP", table="2", source="Schwarz 1890; Schoen 1970", paper_nodes=12,
+        description="Plateau patch over a skew hexagon of six straight lines with right angles: "
+                    "a vertical edge on the z axis, a bottom edge along x in z = 0, a vertical edge "
+                    "at (1/2, 0), a top edge along y in z = 1/2, a vertical edge at (1/2, 1/2) and "
+                    "the diagonal x = y at z = 1/4 back to the start. Horizontal lines along x in "
+                    "the layers z = 0 and along y in z = 1/2 (the crossed layers of parallels). "
+                    "Table 4 lists a direct surface; here the mixed minimal type's Plateau route "
+                    "(nothing slides), exactly minimal. Half-turns about the diagonal, about the "
+                    "vertical edge at (1/2, 0) and about the bottom edge make the 8 patches of the "
+                    "tetragonal cell, here with c/a = 1 (any c/a is a member of the CLP family).")
+    s = _closed_surface(g, "hexagon", CLP_HEXAGON, "mixed_minimal", edge_length=0.025, max_iter=600)
+    t = g.transform("half_turn_diagonal", s, angle=180.0, origin=CLP_HEXAGON[0], axis=[1, 1, 0])
+    t = g.transform("half_turn_vertical", t, angle=180.0, origin=CLP_HEXAGON[2], axis=[0, 0, 1])
+    t = g.transform("half_turn_bottom", t, angle=180.0, origin=CLP_HEXAGON[1], axis=[1, 0, 0])
+    return _finish(g, t)
+
+
+# Schwarz H: the catenoid-like annulus between two parallel equilateral
+# triangles (edge 1, centred on the z axis, in z = +-H_HALF_GAP), cut by its
+# mirror planes into 12 pieces.  One piece lies in the prism over the triangle
+# (centre O, edge midpoint M, vertex V), 0 <= z <= H_HALF_GAP: the half edge
+# M-V is fixed (a straight line of the surface); the surface meets the
+# mirror planes x = 0 (through O and V), the plane through O and M and z = 0
+# at right angles, so those three arcs slide.  Gauss-Bonnet: angles 90, 30,
+# 90, 90 degrees give -pi/3 per piece; 24 pieces per hexagonal cell: genus 3.
+H_HALF_GAP = 0.2
+H_R = 1 / math.sqrt(3)                                   # circumradius of the unit triangle
+H_COS30, H_SIN30 = math.sqrt(3) / 2, 0.5
+H_CELL = [1.0, math.sqrt(3), 4 * H_HALF_GAP]             # orthorhombic cell of the hexagonal lattice
+H_PRISM = [[[-1, 0, 0], 0], [[H_SIN30, -H_COS30, 0], 0], [[H_COS30, H_SIN30, 0], H_R / 2],
+           [[0, 0, -1], 0], [[0, 0, 1], H_HALF_GAP]]
+
+
+def schwarz_h() -> SurfaceGraph:
+    t, m = H_HALF_GAP, [H_R / 2 * H_COS30, H_R / 2 * H_SIN30]
+    g = SurfaceGraph(
+        "schwarz_h", title="Schwarz H", table="2", source="Schwarz 1890; Schoen 1970", paper_nodes=22,
+        description="Mixed minimal surface in the prism over the triangle (centre, edge midpoint, "
+                    "vertex) of an equilateral triangle of edge 1, 0 <= z <= 0.2: the half edge from "
+                    "the midpoint to the vertex in z = 0.2 is fixed (a straight line of the surface); "
+                    "the arcs on x = 0, on the plane through the centre and the midpoint and on z = 0 "
+                    "slide. Mirrors in x = 0 and z = 0 and copies at 120 and 240 degrees make the "
+                    "annulus between the two triangles; a half-turn about the top edge and a "
+                    "translation by (1/2, sqrt(3)/2, 0) fill the orthorhombic cell 1 x sqrt(3) x 0.8 "
+                    "of the hexagonal lattice (c/a = 0.8; the H family is deformed by c/a). Table 2's "
+                    "row is 'Deformed H' with a 10-vertex loop shown only in its figure: this is the "
+                    "undeformed family member built from the same kind of mixed minimal loop.")
+    vs = g.vertices("v_", [[m[0], m[1], t], [0, H_R, t], [0, 0.3, 0], [0.15 * H_COS30, 0.15 * H_SIN30, 0]])
+    chains = [g.chain("e_edge", vs[0:2]), g.chain("e_on_x0", vs[1:3], smooth=True),
+              g.chain("e_on_z0", vs[2:4], smooth=True), g.chain("e_on_om", [vs[3], vs[0]], smooth=True)]
+    s = g.surface("s_piece", chains, "mixed_minimal", edge_length=0.02, fbv="custom", fbv_planes=H_PRISM,
+                  max_iter=2000)
+    t2 = g.mirror("mirror_x", s, [1, 0, 0])
+    a = g.transform("rot120_z", t2, angle=120.0, axis=[0, 0, 1])
+    b = g.transform("rot240_z", t2, angle=240.0, axis=[0, 0, 1], copy=False)
+    annulus = g.mirror("mirror_z", g.group("about_z", [a, b]), [0, 0, 1])
+    pair = g.transform("half_turn_edge", annulus, angle=180.0, origin=[m[0], m[1], t],
+                       axis=[-m[0], H_R - m[1], 0])
+    cell = g.transform("centring", pair, translation=[0.5, math.sqrt(3) / 2, 0])
+    return _finish(g, cell, cell=H_CELL)
 
 
 # Generators of the gyroid's 16 patches, found by search over the proper
@@ -394,6 +473,8 @@ EXAMPLES: dict[str, Callable[[], SurfaceGraph]] = {
     "schwarz_d": schwarz_d,
     "gyroid": gyroid,
     "wei_genus4": wei_genus4,
+    "schwarz_clp": schwarz_clp,
+    "schwarz_h": schwarz_h,
     "schwarz_p_neovius": schwarz_p_neovius,
     "schwarz_p_cubic_open": schwarz_p_cubic_open,
     "schwarz_p_cubic_closed": schwarz_p_cubic_closed,

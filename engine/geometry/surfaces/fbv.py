@@ -44,7 +44,7 @@ __all__ = ["BoundingVolume", "Violation", "FBVError", "FBVFitError", "LoopOnFBV"
            "fit_fbv", "sliding_planes", "DEFAULT_TOL"]
 
 # Distances below this fraction of the FBV diameter count as "on a plane".
-DEFAULT_TOL = 1e-7
+DEFAULT_TOL = 1e-5
 
 
 @dataclass(frozen=True)

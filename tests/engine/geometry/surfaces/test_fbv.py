@@ -175,3 +175,18 @@ def test_sliding_planes_pick_a_face_or_say_why_not():
     across = [np.array([[0, 0, .5], [1, 1, .5]])]
     (why,) = sliding_planes(box, across, [True], square)
     assert "sliding-on-face" in why
+
+
+def test_points_typed_to_six_decimals_still_lie_on_oblique_faces():
+    # A hexagonal prism piece (centre, edge midpoint, vertex of a unit
+    # triangle): its side faces are at 30 and 60 degrees, so vertices typed
+    # with six decimals sit up to ~1e-6 off them -- still "on the face".
+    r = 1 / math.sqrt(3)
+    c, s = math.sqrt(3) / 2, 0.5
+    fbv = convex_volume([[-1, 0, 0], [s, -c, 0], [c, s, 0], [0, 0, -1], [0, 0, 1]], [0, 0, r / 2, 0, 0.2])
+    typed = np.round([[r / 2 * c, r / 2 * s, 0.2], [0.15 * c, 0.15 * s, 0.0]], 6)
+    on, inside = locate_points(fbv, typed)
+    assert inside.all()
+    assert len(on[0]) == 3 and len(on[1]) == 2          # top, side, mirror / bottom, mirror
+    # ... while a point 1e-3 outside is refused.
+    assert not locate_points(fbv, typed + [1e-3, 0, 0])[1][0]
