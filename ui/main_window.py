@@ -27,6 +27,7 @@ from .growth_panel import GrowthPanel
 from .phasor_panel import PhasorPanel
 from .rd_panel import RDPanel
 from .study_panel import StudyPanel
+from .surface_panel import SurfacePanel
 from .tileset_editor import TileSetEditor
 from .inspector import Inspector
 from .node_editor import NodeEditor
@@ -128,6 +129,14 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tabifyDockWidget(self.inspector_dock, self.study_dock)
         self.study_panel.study_finished.connect(
             lambda code: self.log("info" if code == 0 else "warning", f"study finished with exit code {code}"))
+        self.surface_panel = SurfacePanel(self.doc, self.undo, self)
+        self.surface_dock = self._dock("Surfaces", self.surface_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
+        self.tabifyDockWidget(self.inspector_dock, self.surface_dock)
+        self.surface_panel.evaluate_requested.connect(self.evaluate_now)
+        self.surface_panel.node_selected.connect(self.editor.select)
+        self.surface_panel.message.connect(self.log)
+        self.editor.selection_changed.connect(self.surface_panel.set_selected)
+        self.evaluation_finished.connect(self.surface_panel.set_report)
         self.inspector_dock.raise_()
 
         bottom = QtWidgets.QWidget()
@@ -575,7 +584,7 @@ class MainWindow(QtWidgets.QMainWindow):
         from engine.geometry.marching import periodic_mesh
         # One marching-cubes pass over the tiled field gives a watertight block
         # (copies of the cell mesh would leave duplicate seams).
-        return periodic_mesh(solid.sdf, tiles=(tiles, tiles, tiles), cell_size=solid.cell_size)
+        return periodic_mesh(solid.sdf, tiles=(tiles, tiles, tiles), cell_size=solid.cell_size, cell=solid.cell)
 
     # -- autosave / recovery --------------------------------------------------------------
     def autosave_now(self) -> bool:
@@ -643,6 +652,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.growth_panel.detach()
         self.phasor_panel.shutdown()
         self.rd_panel.shutdown()
+        self.surface_panel.shutdown()
         self.worker.shutdown()
         self.editor.detach()
         self.inspector.detach()

@@ -72,6 +72,8 @@ _MIN_PIECES = 8
 _CONJUGATE_ENERGY_WARN = 1e-3
 # Relative area change per Pinkall-Polthier step that ends a fixed-boundary solve.
 _PLATEAU_TOL = 1e-9
+# Most entries of the energy history a SurfaceReport carries (enough for a chart).
+HISTORY_POINTS = 400
 
 
 # ----------------------------------------------------------- json params
@@ -114,6 +116,33 @@ def _check_points(data):
     return out
 
 
+# ------------------------------------------------------------- the history
+
+def energy_history(values, final, *, limit=HISTORY_POINTS):
+    """A solver's energy history as a short JSON-able list ending on the reported energy.
+
+    Parameters
+    ----------
+    values : (k,) float, the energy after each solver step (non-finite entries are dropped)
+    final : float, the energy the report states; it replaces a last entry within
+        round-off of it and is appended otherwise
+    limit : int, most entries kept; a longer history is thinned evenly, first and last kept
+
+    Returns
+    -------
+    list of float, at most ``limit`` entries
+    """
+    h = np.asarray(values, dtype=np.float64).ravel()
+    h = h[np.isfinite(h)]
+    final = float(final)
+    if h.size and abs(h[-1] - final) <= 1e-12 * max(1.0, abs(final)):
+        h = h[:-1]
+    h = np.append(h, final) if math.isfinite(final) else h
+    if h.size > limit:
+        h = h[np.unique(np.round(np.linspace(0, h.size - 1, limit)).astype(np.int64))]
+    return [float(x) for x in h]
+
+
 # ---------------------------------------------------------------- the loop
 
 def _loop_chains(chains):
@@ -144,6 +173,31 @@ def _loop_chains(chains):
         smooth.append(bool(chain.smooth))
         owners += [(index[id(chain)], j) for j in ids[:-1]]
     return polys, smooth, owners
+
+
+def boundary_schematic(chains):
+    """The loop a Surface node spans, for drawing (what slides is the solver's business).
+
+    Parameters
+    ----------
+    chains : sequence of EdgeChain, the node's ``chains`` input
+
+    Returns
+    -------
+    points : (k, 3) float64, loop vertices in loop order (unit-cell coordinates)
+    owners : list of (input chain index, vertex index in that chain), one per loop vertex
+    segment_chain : (k,) int64, loop-order chain of segment i (loop vertex i to i + 1)
+    smooth : list of bool, per loop-order chain
+
+    Raises
+    ------
+    NodeInputError
+        The chains do not form one closed loop.
+    """
+    polys, smooth, owners = _loop_chains(chains)
+    points = np.vstack([p[:-1] for p in polys])
+    segment_chain = np.concatenate([np.full(len(p) - 1, c, dtype=np.int64) for c, p in enumerate(polys)])
+    return points, owners, segment_chain, smooth
 
 
 def _join(polys, modes, planes=None):
@@ -180,8 +234,9 @@ def _solve_direct(polys, smooth, params, ctx):
         raise NodeInputError(str(exc), where="chains") from None
     warning = "" if sol.converged else (f"the thin shell did not converge within max_iter="
                                         f"{params['max_iter']} iterations")
-    return (sol.vertices, sol.faces, sol.boundary, sol.iterations, float(sol.energy_history[-1]),
-            sol.converged, warning, {"alpha": params["alpha"]})
+    energy = float(sol.energy_history[-1])
+    return (sol.vertices, sol.faces, sol.boundary, sol.iterations, energy, sol.converged, warning,
+            {"alpha": params["alpha"], "energy_history": energy_history(sol.energy_history, energy)})
 
 
 def _solve_mixed(polys, smooth, points, fbv, params, ctx):
@@ -204,7 +259,8 @@ def _solve_mixed(polys, smooth, points, fbv, params, ctx):
     sliding = [{"chain": c, "plane": fbv.labels[p], "source": "fbv face"}
                for c, p in enumerate(planes) if p is not None]
     return (sol.vertices, sol.faces, sol.boundary, sol.iterations, float(sol.area), sol.converged,
-            warning, {"sliding": sliding, "route": "mixed minimal flow"})
+            warning, {"sliding": sliding, "route": "mixed minimal flow",
+                      "energy_history": energy_history(sol.area_history, sol.area)})
 
 
 def _solve_fixed(points, params, ctx):
@@ -215,7 +271,9 @@ def _solve_fixed(points, params, ctx):
     warning = "" if sol.converged else (f"the Plateau iteration did not converge within max_iter="
                                         f"{params['max_iter']} steps")
     return (sol.vertices, sol.faces, b, int(sol.iterations[0]), float(sol.level_areas[-1]),
-            sol.converged, warning, {"sliding": [], "route": "plateau (no sliding chain)"})
+            sol.converged, warning, {"sliding": [], "route": "plateau (no sliding chain)",
+                                     "energy_history": energy_history(sol.area_history,
+                                                                      sol.level_areas[-1])})
 
 
 def _conjugate_error(exc, owners):
@@ -254,7 +312,12 @@ def _solve_conjugate(points, owners, fbv, params, ctx):
             f"the patch fits its FBV poorly (contour energy {rep['energy']:.3g})")
     details = {"energy_kind": rep["energy_kind"], "evaluations": rep["evaluations"],
                "conjugate_sign": rep["conjugate_sign"], "snap_max": rep["snap_max"],
-               "note": "every segment slides on its FBV face; chain smoothness is not used"}
+               "note": "every segment slides on its FBV face; chain smoothness is not used",
+               # the lowest energy found after each evaluation (a Nelder-Mead iteration makes one
+               # or more); the search re-meshes between its two stages, so the reported energy
+               # (the second stage's best) may close it slightly above that running minimum
+               "energy_history": energy_history(np.minimum.accumulate(rep["energy_history"]),
+                                                rep["energy"])}
     return (patch.vertices, patch.faces, b, int(rep["iterations"]), float(rep["energy"]),
             bool(rep["converged"]), warning, details)
 
