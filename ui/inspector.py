@@ -25,6 +25,30 @@ from engine.graph.values import Stiffness
 from .stiffness_panel import StiffnessPanel
 
 MERGE_SECONDS = 1.0
+
+
+class MergingParamPush:
+    """Pushes SetParam on an undo stack; quick repeats of the same parameter
+    (a spin box being scrolled) merge into one undo item."""
+
+    def __init__(self, undo):
+        self.undo = undo
+        self._last: tuple[tuple[str, str], float] | None = None
+
+    def reset(self) -> None:
+        self._last = None
+
+    def push(self, node_id: str, name: str, value: Any) -> None:
+        """Push the edit; a refused value raises GraphError and ends the merge run."""
+        key, now = (node_id, name), time.monotonic()
+        merge = (self._last is not None and self._last[0] == key and now - self._last[1] < MERGE_SECONDS
+                 and self.undo.undo_text() == f"set {node_id}.{name}")
+        try:
+            self.undo.push(SetParam(node_id, name, value), merge=merge)
+        except GraphError:
+            self._last = None
+            raise
+        self._last = (key, now)
 _BIG = 1e15
 
 
@@ -391,7 +415,7 @@ class Inspector(QtWidgets.QWidget):
         self.editors: dict[str, ParamEditor] = {}
         self._results: dict = {}
         self._outputs: dict = {}
-        self._last_edit: tuple[tuple[str, str], float] | None = None
+        self._edits = MergingParamPush(undo)
 
         outer = QtWidgets.QVBoxLayout(self)
         outer.setContentsMargins(6, 6, 6, 6)
@@ -454,7 +478,7 @@ class Inspector(QtWidgets.QWidget):
         if node_id is not None and node_id not in self.doc.nodes:
             node_id = None
         self.node_id = node_id
-        self._last_edit = None
+        self._edits.reset()
         self._clear_form()
         self.error_label.hide()
         has = node_id is not None
@@ -500,21 +524,14 @@ class Inspector(QtWidgets.QWidget):
         """Push SetParam for the shown node; show a refusal inline."""
         if self.node_id is None:
             return False
-        key = (self.node_id, name)
-        now = time.monotonic()
-        merge = (self._last_edit is not None and self._last_edit[0] == key
-                 and now - self._last_edit[1] < MERGE_SECONDS
-                 and self.undo.undo_text() == f"set {self.node_id}.{name}")
         try:
-            self.undo.push(SetParam(self.node_id, name, value), merge=merge)
+            self._edits.push(self.node_id, name, value)
         except GraphError as exc:
             self.error_label.setText(str(exc))
             self.error_label.show()
             self.message.emit("error", f"refused: {exc}")
             self._refresh_values()
-            self._last_edit = None
             return False
-        self._last_edit = (key, now)
         self.error_label.hide()
         return True
 

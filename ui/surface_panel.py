@@ -25,17 +25,16 @@ from __future__ import annotations
 
 import html
 import re
-import time
 
 import numpy as np
 from PySide6 import QtCore, QtWidgets
 
-from engine.graph import GraphError, SetParam, all_node_types
+from engine.graph import GraphError, all_node_types
 from engine.graph.errors import NodeInputError
 from engine.graph.values import SurfaceReport
 from engine.nodes.surfaces import boundary_schematic
 
-from .inspector import EDITORS, MERGE_SECONDS, STATUS_COLOURS
+from .inspector import EDITORS, STATUS_COLOURS, MergingParamPush
 from .surface_plots import ConvergenceChart, LoopSchematic
 
 SURFACE_NODE_TYPES = ("Surface", "DualSurface", "AssociateFamily")
@@ -147,7 +146,7 @@ class SurfacePanel(QtWidgets.QWidget):
         self.outputs: dict = {}
         self.editors: dict = {}
         self._stale: set[str] = set()      # nodes edited since the report shown
-        self._last_edit = None
+        self._edits = MergingParamPush(undo)
         self._build()
         doc.subscribe(self._on_doc_event)
         self._refresh_list()
@@ -366,7 +365,7 @@ class SurfacePanel(QtWidgets.QWidget):
         for editor in self.editors.values():
             editor.deleteLater()
         self.editors = {}
-        self._last_edit = None
+        self._edits.reset()
         self.refused_label.hide()
         if self.node_id is None:
             return
@@ -395,20 +394,14 @@ class SurfacePanel(QtWidgets.QWidget):
         """Push one SetParam for the shown node; show a refusal inline."""
         if self.node_id is None:
             return False
-        key, now = (self.node_id, name), time.monotonic()
-        merge = (self._last_edit is not None and self._last_edit[0] == key
-                 and now - self._last_edit[1] < MERGE_SECONDS
-                 and self.undo.undo_text() == f"set {self.node_id}.{name}")
         try:
-            self.undo.push(SetParam(self.node_id, name, value), merge=merge)
+            self._edits.push(self.node_id, name, value)
         except GraphError as exc:
             self.refused_label.setText(str(exc))
             self.refused_label.show()
             self.message.emit("error", f"refused: {exc}")
             self._refresh_values()
-            self._last_edit = None
             return False
-        self._last_edit = (key, now)
         self.refused_label.hide()
         return True
 
