@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from .canvas_paint import begin_paint
+
 MARGIN = 6           # px around the picture
 SCALE_BAR_H = 30     # px reserved below the picture for a colour scale
 NAN_RGB = (128, 128, 128)
@@ -209,12 +211,8 @@ class PhasorCanvas(QtWidgets.QWidget):
 
     # -- drawing ------------------------------------------------------------------------------
     def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), self.palette().window())
-        if self._image is None:
-            p.setPen(self.palette().text().color())
-            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, self.placeholder)
-            p.end()
+        p = begin_paint(self, self._image is not None, self.placeholder)
+        if p is None:
             return
         r = self.target_rect()
         p.setRenderHint(QtGui.QPainter.RenderHint.SmoothPixmapTransform, False)

@@ -26,6 +26,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from engine.rd.preview import PLANE_AXES
 
+from .canvas_paint import begin_paint
 from .phasor_canvas import PhasorCanvas, _qimage
 
 COMPARE_MODES = ("now", "before", "split")
@@ -119,12 +120,8 @@ class RDCanvas(PhasorCanvas):
 
     # -- drawing --------------------------------------------------------------------------------
     def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), self.palette().window())
-        if self._image is None:
-            p.setPen(self.palette().text().color())
-            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, self.placeholder)
-            p.end()
+        p = begin_paint(self, self._image is not None, self.placeholder)
+        if p is None:
             return
         r = self.target_rect()
         p.setRenderHint(QtGui.QPainter.RenderHint.SmoothPixmapTransform, False)

@@ -22,6 +22,8 @@ from PySide6 import QtCore, QtGui, QtWidgets
 from engine.growth import DEFECT
 from engine.growth.regions import N_LABELS, densify_stroke, paint_disc
 
+from .canvas_paint import begin_paint
+
 DEFECT_COLOUR = QtGui.QColor(220, 40, 40)
 LABEL_ALPHA = 120
 _BASE_COLOURS = ((0, 0, 0), (31, 119, 255), (255, 127, 14), (44, 190, 44), (214, 39, 40),
@@ -228,12 +230,8 @@ class RegionCanvas(QtWidgets.QWidget):
 
     # -- drawing ------------------------------------------------------------------------------
     def paintEvent(self, _event) -> None:
-        p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), self.palette().window())
-        if self.image is None:
-            p.setPen(self.palette().text().color())
-            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, "no tiling")
-            p.end()
+        p = begin_paint(self, self.image is not None, "no tiling")
+        if p is None:
             return
         p.setRenderHint(QtGui.QPainter.RenderHint.SmoothPixmapTransform, False)
         r = self.target_rect()
