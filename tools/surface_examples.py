@@ -18,10 +18,12 @@ statistics of Table 4 (each description says what was chosen).
 Schwarz CLP and Schwarz H are built from their classical constructions (a
 Plateau hexagon of straight lines; a mixed minimal piece of the annulus
 between two triangles, on the hexagonal lattice's orthorhombic cell); Table
-2's "Deformed H" row is represented by that H family member.
+2's "Deformed H" row is represented by that H family member. Steffmann's
+surface is the conjugate of I-WP: a Plateau hexagon whose edge lengths are
+the ones the I-WP example's edge-length search finds.
 
-Not built: Schoen S'-S'' and its deformation, Steffmann, Schoen R2 and Hao
-Chen's aD/tD. Their fundamental patches (vertex positions, smooth flags, FBV)
+Not built: Schoen S'-S'' and its deformation, Schoen R2 and Hao Chen's
+aD/tD. Their fundamental patches (vertex positions, smooth flags, FBV)
 are given only in the paper's Table 2 figure, which its text does not carry.
 Of the 7-vertex conjugate loops a cube FBV admits, only Wei's converges (the
 other three types stop at contour energies 1e-2 to 4e-2), so S'-S'' needs an
@@ -225,6 +227,36 @@ def wei_genus4() -> SurfaceGraph:
                                         [.5, .25, 0], [.5, .5, .25], [.25, .5, .5]],
                         "conjugate", edge_length=0.025, max_iter=200)
     return _finish(g, g.octant_mirrors("", s))
+
+
+# Steffmann (Stessmann 1934): the conjugate of Schoen's I-WP. I-WP's patch
+# (see ``schoen_iwp``) has planar arcs on y = 0, x = y, z = 1/2, x = 1/2, x = y
+# and z = 0 with corner angles 90, 45, 90, 90, 45, 90 degrees; its conjugate
+# is bounded by straight lines along those planes' normals with the same
+# angles, and the edge-length search of the I-WP example finds lengths
+# 2 : sqrt(2) : 1 : 2 : sqrt(2) : 1 (0.50678, 0.35842, 0.25347, ... in its
+# dual). Scaled so half-turns about the edges generate the lattice of the unit
+# cube: 8 patches per cell (the rotation group is D4), Gauss-Bonnet
+# -3 pi / 2 per patch, genus 4 per cell.
+STEFFMANN_HEXAGON = [[0, 0, 0], [0, 1, 0], [.5, .5, 0], [.5, .5, .5], [-.5, .5, .5], [0, 0, .5]]
+
+
+def steffmann() -> SurfaceGraph:
+    g = SurfaceGraph(
+        "steffmann", title="Steffmann", table="2", source="Stessmann 1934; conjugate of Schoen's I-WP",
+        paper_nodes=13,
+        description="Plateau patch over a skew hexagon of straight lines along the normals of I-WP's "
+                    "mirror planes (y, x - y, z, x, x - y, z), lengths 1 : sqrt(2)/2 : 1/2 : 1 : "
+                    "sqrt(2)/2 : 1/2, right angles except 45 degrees after the two diagonal edges: the "
+                    "conjugate of the I-WP patch, whose edge-length search gives these ratios. Table 4 "
+                    "lists a direct surface; here the mixed minimal type's Plateau route (nothing "
+                    "slides), exactly minimal. Half-turns about the y axis, the z axis and the "
+                    "diagonal edge in z = 0 make the 8 patches of the cubic cell.")
+    s = _closed_surface(g, "hexagon", STEFFMANN_HEXAGON, "mixed_minimal", edge_length=0.025, max_iter=600)
+    t = g.transform("half_turn_y", s, angle=180.0, axis=[0, 1, 0])
+    t = g.transform("half_turn_z", t, angle=180.0, axis=[0, 0, 1])
+    t = g.transform("half_turn_diagonal", t, angle=180.0, origin=STEFFMANN_HEXAGON[1], axis=[1, -1, 0])
+    return _finish(g, t)
 
 
 # Schwarz CLP: half of the Plateau octagon over the square [0, 1/2]^2 whose
@@ -474,6 +506,7 @@ EXAMPLES: dict[str, Callable[[], SurfaceGraph]] = {
     "gyroid": gyroid,
     "wei_genus4": wei_genus4,
     "schwarz_clp": schwarz_clp,
+    "steffmann": steffmann,
     "schwarz_h": schwarz_h,
     "schwarz_p_neovius": schwarz_p_neovius,
     "schwarz_p_cubic_open": schwarz_p_cubic_open,

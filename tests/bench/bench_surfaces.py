@@ -36,7 +36,7 @@ PAPER = [
     ("Schoen S'-S''", 2, 14.16, 14, None),
     ("Schoen I-WP", 2, 3.20, 14, "schoen_iwp"),
     ("Deformed Schoen S'-S''", 2, 21.91, 14, None),
-    ("Steffmann", 2, 1.33, 13, None),
+    ("Steffmann", 2, 1.33, 13, "steffmann"),
     ("Schwarz D", 2, 0.72, 12, "schwarz_d"),
     ("Schwarz CLP", 2, 0.82, 12, "schwarz_clp"),
     ("Schoen R2", 2, 1.46, 18, None),

@@ -41,6 +41,7 @@ PAPER_NODE_COUNT = {
     "tpms_schwarz_p_cubic_open": 25, "tpms_schwarz_p_cubic_closed": 22,
     "tpms_non_manifold_surface": 20, "tpms_polyhedral_cell": 13, "tpms_our_composition": 30,
     "tpms_star_shaped": 15, "tpms_schwarz_clp": 12, "tpms_schwarz_h": 22,
+    "tpms_steffmann": 13,
 }
 # Graphs that differ from the paper's count by more than 30%, and why.
 NODE_COUNT_EXCEPTIONS = {
@@ -186,15 +187,39 @@ def _worst_seam(patches):
 def test_patches_weld_into_a_closed_surface_of_the_published_genus(name):
     doc, report = _evaluated(EXAMPLES_DIR / f"{name}.json")
     (obj,) = [n for n in doc.nodes.values() if n.type_name == "Object"]
-    faces = _welded_faces(_object_skeleton(doc, report).surfaces, obj.params.get("cell", (1.0, 1.0, 1.0)))
+    faces, _ = _welded_faces(_object_skeleton(doc, report).surfaces, obj.params.get("cell", (1.0, 1.0, 1.0)))
     edges = np.sort(np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
     unique, uses = np.unique(edges, axis=0, return_counts=True)
     assert np.all(uses == 2), f"{np.sum(uses != 2)} edges not shared by exactly two faces"
     assert np.unique(faces).size - len(unique) + len(faces) == CELL_EULER[name]
 
 
+def test_steffmann_crosses_itself_only_along_its_edge_lines():
+    # Steffmann's surface (the adjoint of I-WP) contains 4-fold axes: along
+    # its edge lines through (0, 0) and (1/2, 1/2) in each axis direction two
+    # sheets cross at right angles. Everywhere else the welded patches form
+    # a closed surface.
+    doc, report = _evaluated(EXAMPLES_DIR / "tpms_steffmann.json")
+    patches = _object_skeleton(doc, report).surfaces
+    faces, position = _welded_faces(patches, (1.0, 1.0, 1.0))
+    edges = np.sort(np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, uses = np.unique(edges, axis=0, return_counts=True)
+    assert set(np.unique(uses)) == {2, 4}
+    ends = position[unique[uses == 4]]                                   # (m, 2, 3)
+
+    def on(axis, value):                                                 # both ends, modulo the cell
+        d = np.abs(ends[..., axis] - value) % 1.0
+        return (np.minimum(d, 1.0 - d) < 1e-4).all(axis=1)
+
+    on_lines = np.zeros(len(ends), bool)
+    for b, c in ((1, 2), (0, 2), (0, 1)):          # lines along x, y, z
+        on_lines |= (on(b, 0) & on(c, 0)) | (on(b, .5) & on(c, .5))
+    assert on_lines.all()
+
+
 def _welded_faces(patches, cell, tol=1e-4):
-    """All patches' faces over vertices merged when they coincide modulo the cell."""
+    """All patches' faces over vertices merged when they coincide modulo the
+    cell, and the merged vertices' positions in the cell."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -206,7 +231,10 @@ def _welded_faces(patches, cell, tol=1e-4):
     n = len(points)
     _, labels = connected_components(coo_matrix((np.ones(len(pairs)), pairs.T), shape=(n, n)), directed=False)
     faces = labels[np.vstack([p.faces + o for p, o in zip(patches, offsets)])]
-    return faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])]
+    position = np.zeros((labels.max() + 1, 3))
+    position[labels] = points
+    keep = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    return faces[keep], position
 
 
 def test_gyroid_is_periodic_only_at_the_right_scale():

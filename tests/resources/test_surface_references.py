@@ -1,4 +1,4 @@
-"""Schwarz CLP and Schwarz H examples against independent references.
+"""Schwarz CLP, Schwarz H and Steffmann examples against independent references.
 
 Neither surface has a published area we can quote, so each is checked
 against a straightforward solver written here, which shares nothing with
@@ -14,6 +14,8 @@ the engine's Pinkall-Polthier / mixed minimal code:
   boundary rings fixed on the triangles, L-BFGS over all interior vertices.
   It checks exactly what the mixed minimal solver adds -- that arcs sliding
   on mirror planes give the unconstrained minimal surface.
+* Steffmann: the Plateau patch on its straight hexagon is compared with the
+  I-WP patch from the conjugate surface construction, its conjugate.
 """
 
 from __future__ import annotations
@@ -174,3 +176,24 @@ def test_h_piece_equals_the_unconstrained_minimal_annulus():
     neck = np.hypot(*ref_vertices[np.abs(ref_vertices[:, 2]) < 1e-3, :2].T).min()
     piece_neck = np.hypot(*patch.vertices[np.abs(patch.vertices[:, 2]) < 1e-9, :2].T).min()
     assert abs(neck - piece_neck) < 0.003
+
+
+# -------------------------------------------------------------- Steffmann
+
+def test_steffmann_is_isometric_to_the_i_wp_patch():
+    # Steffmann's patch is the conjugate of I-WP's, built independently: a
+    # Plateau solve on the straight hexagon here, the conjugate surface
+    # construction there. Conjugation is an isometry, so the areas scale as
+    # the square of the boundary lengths (the hexagon's perimeter is
+    # 1 + sqrt(2)/2 + 1/2 + 1 + sqrt(2)/2 + 1/2 = 3 + sqrt(2)).
+    steffmann = _patch("tpms_steffmann", "s_hexagon")
+    doc = load_project(EXAMPLES_DIR / "tpms_schoen_iwp.json")
+    (surface,) = [n for n, node in doc.nodes.items() if node.type_name == "Surface"]
+    report = Evaluator().evaluate(doc, targets=[surface])
+    (iwp,) = report.outputs[surface]["skeleton"].surfaces
+    loop = np.vstack([iwp.boundary, iwp.boundary[:1]])
+    perimeter = np.linalg.norm(np.diff(loop, axis=0), axis=1).sum()
+    expected = surface_area(iwp.vertices, iwp.faces) * ((3 + math.sqrt(2)) / perimeter) ** 2
+    found = surface_area(steffmann.vertices, steffmann.faces)
+    print(f"Steffmann patch area {found:.5f}, I-WP patch scaled by the perimeters {expected:.5f}")
+    assert abs(found / expected - 1) < 0.003
