@@ -22,12 +22,13 @@ between two triangles, on the hexagonal lattice's orthorhombic cell); Table
 surface is the conjugate of I-WP: a Plateau hexagon whose edge lengths are
 the ones the I-WP example's edge-length search finds.
 
-Not built: Schoen S'-S'' and its deformation, Schoen R2 and Hao Chen's
-aD/tD. Their fundamental patches (vertex positions, smooth flags, FBV)
-are given only in the paper's Table 2 figure, which its text does not carry.
-Of the 7-vertex conjugate loops a cube FBV admits, only Wei's converges (the
-other three types stop at contour energies 1e-2 to 4e-2), so S'-S'' needs an
-FBV we could not identify.
+Schoen S'-S'' is built in its reflectional cell, a prism over the (2, 4, 4)
+triangle, at c/a = 0.7, and its deformation at c/a = 0.5 (the paper's loops
+for both are in its figure only; a cube FBV, c/a = 1, does not close).
+
+Not built: Schoen R2 and Hao Chen's aD/tD. Their fundamental patches (vertex
+positions, smooth flags, FBV) are given only in the paper's Table 2 figure,
+which its text does not carry.
 
 Usage::
 
@@ -257,6 +258,43 @@ def steffmann() -> SurfaceGraph:
     t = g.transform("half_turn_z", t, angle=180.0, axis=[0, 0, 1])
     t = g.transform("half_turn_diagonal", t, angle=180.0, origin=STEFFMANN_HEXAGON[1], axis=[1, -1, 0])
     return _finish(g, t)
+
+
+# Schoen S'-S'': a tetragonal family of genus 4. Its reflectional cell is the
+# prism over the (2, 4, 4) triangle B (0, 0), A (1/2, 0), C (1/2, 1/2): in the
+# slab z in [0, h] a neck surrounds the 2-fold axis at A (waist in z = 0) and a
+# neck the 4-fold axis at B (waist in z = h), and the sheet between them
+# crosses the 4-fold axis at C. The free-boundary piece has five arcs, on
+# y = 0, z = h, x = y, x = 1/2 and z = 0, with corners of 90 degrees except
+# 45 at C: Gauss-Bonnet -3 pi / 4 per piece, 16 per cell, genus 4. The family
+# is parametrised by c/a = 2h; the construction closes for h up to about
+# 0.37 (at h = 0.5 the contour energy stays at 6e-4).
+def _schoen_s_s(name: str, title: str, half_height: float, paper_nodes: int, extra: str) -> SurfaceGraph:
+    h = half_height
+    g = SurfaceGraph(
+        name, title=title, table="2", source="Schoen 1970", paper_nodes=paper_nodes,
+        description="Free-boundary pentagon in the prism over the triangle (0, 0), (1/2, 0), (1/2, 1/2), "
+                    f"0 <= z <= {h:g}: arcs on y = 0, z = {h:g}, x = y, x = 1/2 and z = 0, one vertex on "
+                    "the vertical edge at (1/2, 1/2) where the sheet crosses the 4-fold axis; a "
+                    "conjugate surface. A mirror in x = y and mirrors in x = 0, y = 0, z = 0 make the "
+                    f"16 pieces of the tetragonal cell 1 x 1 x {2 * h:g} (necks around the 4-fold axes "
+                    "in one slab, around the 2-fold axes in the other: genus 4). " + extra)
+    planes = [[[0, -1, 0], 0], [[1, 0, 0], 0.5], [[-1, 1, 0], 0], [[0, 0, -1], 0], [[0, 0, 1], h]]
+    s = _closed_surface(g, "pentagon", [[.3, 0, 0], [.2, 0, h], [.1, .1, h], [.5, .5, h / 2], [.5, .2, 0]],
+                        "conjugate", edge_length=0.025, fbv="custom", fbv_planes=planes, max_iter=80)
+    m = g.mirror("mirror_xy", s, [1, -1, 0])
+    return _finish(g, g.octant_mirrors("", m), cell=[1.0, 1.0, 2 * h])
+
+
+def schoen_s_s() -> SurfaceGraph:
+    return _schoen_s_s("schoen_s_s", "Schoen S'-S''", 0.35, 14,
+                       "The family member at c/a = 0.7; the paper's 7-vertex loop is in its figure only.")
+
+
+def deformed_schoen_s_s() -> SurfaceGraph:
+    return _schoen_s_s("deformed_schoen_s_s", "Deformed Schoen S'-S''", 0.25, 14,
+                       "The family deformed to c/a = 0.5 (flatter slabs, smaller necks); the paper's "
+                       "deformation is in its figure only.")
 
 
 # Schwarz CLP: half of the Plateau octagon over the square [0, 1/2]^2 whose
@@ -507,6 +545,8 @@ EXAMPLES: dict[str, Callable[[], SurfaceGraph]] = {
     "wei_genus4": wei_genus4,
     "schwarz_clp": schwarz_clp,
     "steffmann": steffmann,
+    "schoen_s_s": schoen_s_s,
+    "deformed_schoen_s_s": deformed_schoen_s_s,
     "schwarz_h": schwarz_h,
     "schwarz_p_neovius": schwarz_p_neovius,
     "schwarz_p_cubic_open": schwarz_p_cubic_open,
