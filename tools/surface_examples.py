@@ -26,9 +26,11 @@ Schoen S'-S'' is built in its reflectional cell, a prism over the (2, 4, 4)
 triangle, at c/a = 0.7, and its deformation at c/a = 0.5 (the paper's loops
 for both are in its figure only; a cube FBV, c/a = 1, does not close).
 
-Not built: Schoen R2 and Hao Chen's aD/tD. Their fundamental patches (vertex
-positions, smooth flags, FBV) are given only in the paper's Table 2 figure,
-which its text does not carry.
+Schoen R2 is H with right isosceles triangles.
+
+Not built: Hao Chen's aD/tD. Its fundamental patch (vertex positions, smooth
+flags, FBV) is given only in the paper's Table 2 figure, which its text does
+not carry.
 
 Usage::
 
@@ -297,6 +299,44 @@ def deformed_schoen_s_s() -> SurfaceGraph:
                        "deformation is in its figure only.")
 
 
+# Schoen R2: Schwarz H with the equilateral triangles replaced by right
+# isosceles ones. A catenoid-like annulus spans two aligned 45-45-90
+# triangles (legs R2_LEG along x and y from the origin, in z = +-R2_HALF_GAP);
+# the mirror x = y and the mirror z = 0 cut it into four pieces, each bounded
+# by a fixed polyline (half the top triangle: the leg along x and half the
+# hypotenuse) and three arcs sliding on x = y, z = 0 and x = y. Gauss-Bonnet:
+# angles 45, 45, 90, 90, 90 degrees give -pi per piece, -4 pi per annulus;
+# half-turns about the triangle edges and the vertical axis at the right
+# angle place 8 annuli in the cell 1 x 1 x 4 h (genus 9 for that cell).
+R2_LEG = 0.5
+R2_HALF_GAP = 0.1
+
+
+def schoen_r2() -> SurfaceGraph:
+    a, t = R2_LEG, R2_HALF_GAP
+    g = SurfaceGraph(
+        "schoen_r2", title="Schoen R2", table="2", source="Schoen 1970", paper_nodes=18,
+        description="Mixed minimal surface: a quarter of the annulus between two aligned right "
+                    f"isosceles triangles (legs {a:g} along x and y from the origin, in z = +-{t:g}). The "
+                    "top leg along x and half the hypotenuse are one fixed chain; three arcs slide on "
+                    "x = y, z = 0 and x = y. Mirrors in x = y and z = 0 make the annulus; half-turns "
+                    "about the top leg, the top hypotenuse and the vertical axis at the right angle "
+                    f"place the 8 annuli of the cell 1 x 1 x {4 * t:g}. The paper's 8-vertex loop is in "
+                    "its figure only; this is the construction with the same kind of loop.")
+    # the waist arc gets a middle vertex off the diagonal, so it lies on z = 0 only
+    vs = g.vertices("v_", [[0, 0, t], [a, 0, t], [a / 2, a / 2, t], [.22, .22, 0], [.2, .08, 0], [.08, .08, 0]])
+    chains = [g.chain("e_triangle", vs[0:3]), g.chain("e_on_diagonal_far", vs[2:4], smooth=True),
+              g.chain("e_on_z0", vs[3:6], smooth=True), g.chain("e_on_diagonal_near", [vs[5], vs[0]], smooth=True)]
+    planes = [[[0, -1, 0], 0], [[-1, 1, 0], 0], [[1, 1, 0], a], [[0, 0, -1], 0], [[0, 0, 1], t]]
+    s = g.surface("s_piece", chains, "mixed_minimal", edge_length=0.01, fbv="custom", fbv_planes=planes,
+                  max_iter=2000)
+    annulus = g.mirror("mirror_z", g.mirror("mirror_xy", s, [1, -1, 0]), [0, 0, 1])
+    u = g.transform("half_turn_leg", annulus, angle=180.0, origin=[0, 0, t], axis=[1, 0, 0])
+    u = g.transform("half_turn_hypotenuse", u, angle=180.0, origin=[a, 0, t], axis=[-1, 1, 0])
+    u = g.transform("half_turn_vertical", u, angle=180.0, axis=[0, 0, 1])
+    return _finish(g, u, cell=[1.0, 1.0, 4 * t])
+
+
 # Schwarz CLP: half of the Plateau octagon over the square [0, 1/2]^2 whose
 # bottom edges (z = 0) run along x on y = 0 and y = 1/2, whose top edges
 # (z = 1/2) run along y on x = 0 and x = 1/2, joined by vertical edges at the
@@ -547,6 +587,7 @@ EXAMPLES: dict[str, Callable[[], SurfaceGraph]] = {
     "steffmann": steffmann,
     "schoen_s_s": schoen_s_s,
     "deformed_schoen_s_s": deformed_schoen_s_s,
+    "schoen_r2": schoen_r2,
     "schwarz_h": schwarz_h,
     "schwarz_p_neovius": schwarz_p_neovius,
     "schwarz_p_cubic_open": schwarz_p_cubic_open,

@@ -39,7 +39,7 @@ PAPER = [
     ("Steffmann", 2, 1.33, 13, "steffmann"),
     ("Schwarz D", 2, 0.72, 12, "schwarz_d"),
     ("Schwarz CLP", 2, 0.82, 12, "schwarz_clp"),
-    ("Schoen R2", 2, 1.46, 18, None),
+    ("Schoen R2", 2, 1.46, 18, "schoen_r2"),
     ("Hao Chen's aD/tD", 2, 0.61, 16, None),
     ("Deformed H (as Schwarz H)", 2, 0.72, 22, "schwarz_h"),
     ("Gyroid", 2, 0.57, 27, "gyroid"),

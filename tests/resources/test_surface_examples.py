@@ -42,6 +42,7 @@ PAPER_NODE_COUNT = {
     "tpms_non_manifold_surface": 20, "tpms_polyhedral_cell": 13, "tpms_our_composition": 30,
     "tpms_star_shaped": 15, "tpms_schwarz_clp": 12, "tpms_schwarz_h": 22,
     "tpms_steffmann": 13, "tpms_schoen_s_s": 14, "tpms_deformed_schoen_s_s": 14,
+    "tpms_schoen_r2": 18,
 }
 # Graphs that differ from the paper's count by more than 30%, and why.
 NODE_COUNT_EXCEPTIONS = {
@@ -55,12 +56,13 @@ CELL_AREA = {"tpms_schwarz_p": 2.3451, "tpms_schwarz_d": 3.8377, "tpms_gyroid": 
 # (genus g per primitive cell, k primitive cells: chi = k (2 - 2g)): P, CLP
 # and H genus 3 (H's orthorhombic cell holds two hexagonal cells), D genus 3
 # (4 primitive cells in the cube), Neovius 9, I-WP 4 (body-centred: 2 per
-# cube), Wei's surface 4, Schoen's S'-S'' 4 (both family members).  The
+# cube), Wei's surface 4, Schoen's S'-S'' 4 (both family members), Schoen's
+# R2 9 for its cell 1 x 1 x 0.4 (8 annuli of -4 pi each).  The
 # gyroid's bent patches meet only to discretisation, so their vertices cannot
 # be welded; Steffmann crosses itself (its own test below).
 CELL_EULER = {"tpms_schwarz_p": -4, "tpms_schwarz_d": -16, "tpms_neovius": -16, "tpms_schoen_iwp": -12,
               "tpms_wei_genus4": -6, "tpms_schwarz_clp": -4, "tpms_schwarz_h": -8,
-              "tpms_schoen_s_s": -6, "tpms_deformed_schoen_s_s": -6}
+              "tpms_schoen_s_s": -6, "tpms_deformed_schoen_s_s": -6, "tpms_schoen_r2": -16}
 AREA_TOL = 0.0015
 
 

@@ -1,4 +1,4 @@
-"""Schwarz CLP, Schwarz H and Steffmann examples against independent references.
+"""Schwarz CLP, Schwarz H, Schoen R2 and Steffmann examples against independent references.
 
 Neither surface has a published area we can quote, so each is checked
 against a straightforward solver written here, which shares nothing with
@@ -9,7 +9,7 @@ the engine's Pinkall-Polthier / mixed minimal code:
   f = 1/2 on x = 0 and x = 1/2 (vertical edges at the corners).  The
   reference minimises the area of the triangulated graph of f on a regular
   grid (L-BFGS over the interior heights) -- no symmetry assumed.
-* H: the annulus between the two triangles is minimised as a whole (no
+* H and R2: the annulus between the two triangles is minimised as a whole (no
   mirror planes, no sliding boundaries): a triangulated annulus with its two
   boundary rings fixed on the triangles, L-BFGS over all interior vertices.
   It checks exactly what the mixed minimal solver adds -- that arcs sliding
@@ -99,20 +99,24 @@ def test_clp_patch_is_the_minimal_graph_over_the_square():
 
 # --------------------------------------------------------------------- H
 
-def _triangle_ring(n: int, radius: float, z: float) -> np.ndarray:
-    corners = [radius * np.array([math.cos(math.radians(a)), math.sin(math.radians(a))])
-               for a in (90, 210, 330)]
+def _equilateral(radius: float) -> np.ndarray:
+    return np.array([radius * np.array([math.cos(math.radians(a)), math.sin(math.radians(a))])
+                     for a in (90, 210, 330)])
+
+
+def _triangle_ring(n: int, corners: np.ndarray, z: float) -> np.ndarray:
     per = n // 3
     ring = [corners[k] + (corners[(k + 1) % 3] - corners[k]) * i / per for k in range(3) for i in range(per)]
     return np.column_stack([np.array(ring), np.full(len(ring), z)])
 
 
-def _minimal_annulus(radius: float, half_gap: float, n: int = 48, m: int = 12):
-    """Least-area triangulated annulus between the triangles in z = +-half_gap."""
-    bottom, top = _triangle_ring(n, radius, -half_gap), _triangle_ring(n, radius, half_gap)
+def _minimal_annulus(corners: np.ndarray, half_gap: float, n: int = 48, m: int = 12):
+    """Least-area triangulated annulus between the triangle ``corners`` in z = +-half_gap."""
+    bottom, top = _triangle_ring(n, corners, -half_gap), _triangle_ring(n, corners, half_gap)
     s = np.linspace(0.0, 1.0, m + 1)[:, None, None]
     rings = (1 - s) * bottom + s * top
-    rings[..., :2] *= 1 - 0.5 * np.sin(np.pi * s)
+    centre = corners.mean(axis=0)
+    rings[..., :2] = centre + (rings[..., :2] - centre) * (1 - 0.5 * np.sin(np.pi * s))
     idx = np.arange((m + 1) * n).reshape(m + 1, n)
     faces = []
     for j in range(m):
@@ -147,25 +151,28 @@ def _dense_samples(v: np.ndarray, f: np.ndarray, k: int = 6) -> np.ndarray:
     return np.einsum("bk,fkd->fbd", bary, v[f]).reshape(-1, 3)
 
 
-def _annulus_from_piece(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The 12 copies of the 1/12 piece: mirror x = 0, rotations about z, mirror z = 0."""
+def _annulus_from_piece(v: np.ndarray, f: np.ndarray, turns: int) -> tuple[np.ndarray, np.ndarray]:
+    """The piece's copies by mirror z = 0 and, for H (``turns`` = 3), mirror x = 0
+    and rotations by 120 degrees about z; for R2 (``turns`` = 1), mirror x = y."""
+    mirror = (lambda p: p * [-1, 1, 1]) if turns == 3 else (lambda p: p[:, [1, 0, 2]])
     pieces = []
     for mirror_z in (1, -1):
-        for mirror_x in (1, -1):
-            for k in range(3):
+        for reflect in (False, True):
+            for k in range(turns):
                 a = 2 * math.pi * k / 3
                 rot = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
-                pieces.append((v * [mirror_x, 1, mirror_z]) @ rot.T)
-    return np.vstack(pieces), np.vstack([f + k * len(v) for k in range(12)])
+                w = v * [1, 1, mirror_z]
+                pieces.append((mirror(w) if reflect else w) @ rot.T)
+    return np.vstack(pieces), np.vstack([f + k * len(v) for k in range(len(pieces))])
 
 
 def test_h_piece_equals_the_unconstrained_minimal_annulus():
     patch = _patch("tpms_schwarz_h", "s_piece")
     radius = 1 / math.sqrt(3)
-    ref_vertices, ref_area = _minimal_annulus(radius, 0.2)
+    ref_vertices, ref_area = _minimal_annulus(_equilateral(radius), 0.2)
     # distance to the mirrored piece, through points sampled 0.02 / 6 apart on
     # its triangles (adds at most ~0.002 to distances near zero)
-    dist, _ = cKDTree(_dense_samples(*_annulus_from_piece(patch.vertices, patch.faces))).query(ref_vertices)
+    dist, _ = cKDTree(_dense_samples(*_annulus_from_piece(patch.vertices, patch.faces, 3))).query(ref_vertices)
     area = 12 * surface_area(patch.vertices, patch.faces)
     print(f"H: reference vertices within {dist.max():.5f} (max) of the mirrored piece; annulus area "
           f"{area:.5f}, coarse reference {ref_area:.5f}")
@@ -197,3 +204,16 @@ def test_steffmann_is_isometric_to_the_i_wp_patch():
     found = surface_area(steffmann.vertices, steffmann.faces)
     print(f"Steffmann patch area {found:.5f}, I-WP patch scaled by the perimeters {expected:.5f}")
     assert abs(found / expected - 1) < 0.003
+
+
+def test_r2_piece_equals_the_unconstrained_minimal_annulus():
+    # Schoen R2: the same whole-annulus check between right isosceles triangles
+    patch = _patch("tpms_schoen_r2", "s_piece")
+    corners = np.array([[0.0, 0.0], [0.5, 0.0], [0.0, 0.5]])
+    ref_vertices, ref_area = _minimal_annulus(corners, 0.1)
+    dist, _ = cKDTree(_dense_samples(*_annulus_from_piece(patch.vertices, patch.faces, 1))).query(ref_vertices)
+    area = 4 * surface_area(patch.vertices, patch.faces)
+    print(f"R2: reference vertices within {dist.max():.5f} (max) of the mirrored piece; annulus area "
+          f"{area:.5f}, coarse reference {ref_area:.5f}")
+    assert dist.max() < 0.005
+    assert abs(ref_area / area - 1) < 0.005
