@@ -1,4 +1,4 @@
-"""The opening every picture canvas's paintEvent shares."""
+"""What the picture canvases share: the paintEvent opening and the painting toggle."""
 
 from __future__ import annotations
 
@@ -16,3 +16,21 @@ def begin_paint(widget, has_picture: bool, placeholder: str) -> QtGui.QPainter |
     p.drawText(widget.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, placeholder)
     p.end()
     return None
+
+
+class PaintingToggle:
+    """Painting mode of a canvas with strokes: a cross cursor while on;
+    switching off drops the stroke in progress (``abort_stroke``)."""
+
+    _painting = False
+
+    def set_painting(self, on: bool) -> None:
+        if not on:
+            self.abort_stroke()
+        self._painting = bool(on)
+        self.setCursor(QtCore.Qt.CursorShape.CrossCursor if on else QtCore.Qt.CursorShape.ArrowCursor)
+        self.update()
+
+    @property
+    def painting(self) -> bool:
+        return self._painting

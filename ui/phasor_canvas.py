@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from .canvas_paint import begin_paint
+from .canvas_paint import PaintingToggle, begin_paint
 
 MARGIN = 6           # px around the picture
 SCALE_BAR_H = 30     # px reserved below the picture for a colour scale
@@ -55,7 +55,7 @@ def _qimage(rgb: np.ndarray) -> QtGui.QImage:
     return QtGui.QImage(rgb.data, w, h, 3 * w, QtGui.QImage.Format.Format_RGB888).copy()
 
 
-class PhasorCanvas(QtWidgets.QWidget):
+class PhasorCanvas(PaintingToggle, QtWidgets.QWidget):
     """A slice picture in mm with outline, glyphs, colour scale and a brush."""
 
     strokeBegan = QtCore.Signal(float, float)    # u, v mm
@@ -119,17 +119,6 @@ class PhasorCanvas(QtWidgets.QWidget):
         """A colour scale below the picture (``lut`` (n, 3) uint8), or None for none."""
         self.scale = None if lut is None else (np.asarray(lut, np.uint8), float(vmin), float(vmax), text)
         self.update()
-
-    def set_painting(self, on: bool) -> None:
-        if not on:
-            self.abort_stroke()
-        self._painting = bool(on)
-        self.setCursor(QtCore.Qt.CursorShape.CrossCursor if on else QtCore.Qt.CursorShape.ArrowCursor)
-        self.update()
-
-    @property
-    def painting(self) -> bool:
-        return self._painting
 
     @property
     def in_stroke(self) -> bool:

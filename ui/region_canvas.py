@@ -22,7 +22,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 from engine.growth import DEFECT
 from engine.growth.regions import N_LABELS, densify_stroke, paint_disc
 
-from .canvas_paint import begin_paint
+from .canvas_paint import PaintingToggle, begin_paint
 
 DEFECT_COLOUR = QtGui.QColor(220, 40, 40)
 LABEL_ALPHA = 120
@@ -58,7 +58,7 @@ def overlay_image(labels: np.ndarray) -> QtGui.QImage:
     return QtGui.QImage(bgra.data, nx, ny, 4 * nx, QtGui.QImage.Format.Format_ARGB32).copy()
 
 
-class RegionCanvas(QtWidgets.QWidget):
+class RegionCanvas(PaintingToggle, QtWidgets.QWidget):
     """A grid picture scaled to fit (nearest neighbour) with defects and painted regions."""
 
     strokeFinished = QtCore.Signal(object)   # (ny, nx) int64 label map after a stroke
@@ -102,17 +102,6 @@ class RegionCanvas(QtWidgets.QWidget):
         """The committed label map (grid shape) to lay over the picture; None for none."""
         self.labels = None if labels is None else np.array(labels, dtype=np.int64)
         self._refresh_overlay()
-
-    def set_painting(self, on: bool) -> None:
-        if not on:
-            self.abort_stroke()
-        self._painting = bool(on)
-        self.setCursor(QtCore.Qt.CursorShape.CrossCursor if on else QtCore.Qt.CursorShape.ArrowCursor)
-        self.update()
-
-    @property
-    def painting(self) -> bool:
-        return self._painting
 
     @property
     def in_stroke(self) -> bool:

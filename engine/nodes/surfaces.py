@@ -84,35 +84,37 @@ def _number(x, what):
     return float(x)
 
 
-def _check_planes(data):
-    what = "a list of [[nx, ny, nz], d] half-spaces n . x <= d (finite numbers, non-zero n)"
+def _vector_value_pairs(data, what):
+    """The ``[[x, y, z], v]`` items of a JSON list as (3 floats, float); anything
+    else raises ValueError(what)."""
     if not isinstance(data, list):
         raise ValueError(what)
-    out = []
+    pairs = []
     for item in data:
         if not (isinstance(item, list) and len(item) == 2 and isinstance(item[0], list)
                 and len(item[0]) == 3):
             raise ValueError(what)
-        n = [_number(x, what) for x in item[0]]
+        pairs.append(([_number(x, what) for x in item[0]], _number(item[1], what)))
+    return pairs
+
+
+def _check_planes(data):
+    what = "a list of [[nx, ny, nz], d] half-spaces n . x <= d (finite numbers, non-zero n)"
+    out = []
+    for n, d in _vector_value_pairs(data, what):
         if not any(n):
             raise ValueError(what)
-        out.append([n, _number(item[1], what)])
+        out.append([n, d])
     return out
 
 
 def _check_points(data):
     what = "a list of [[x, y, z], thickness] pairs (finite numbers, thickness in (0, 1])"
-    if not isinstance(data, list):
-        raise ValueError(what)
     out = []
-    for item in data:
-        if not (isinstance(item, list) and len(item) == 2 and isinstance(item[0], list)
-                and len(item[0]) == 3):
-            raise ValueError(what)
-        value = _number(item[1], what)
+    for point, value in _vector_value_pairs(data, what):
         if not 0.0 < value <= 1.0:
             raise ValueError(what)
-        out.append([[_number(x, what) for x in item[0]], value])
+        out.append([point, value])
     return out
 
 
