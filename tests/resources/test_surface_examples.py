@@ -187,6 +187,23 @@ def _worst_seam(patches):
     return worst
 
 
+def test_every_table_2_conjugate_surface_converges_within_80_iterations():
+    # Makatura et al. Fig. 7: the edge-length search of every Table 2 structure
+    # converges within 80 Nelder-Mead iterations.
+    seen = 0
+    for path in FILES:
+        doc, report = _evaluated(path)
+        if doc.meta["paper_table"] != "2":
+            continue
+        for node_id, node in doc.nodes.items():
+            if node.type_name == "Surface" and node.params["type"] == "conjugate":
+                rep = report.output(node_id, "report")
+                print(f"{path.stem}: {rep.iterations} iterations, contour energy {rep.energy:.2g}")
+                assert rep.converged and rep.iterations <= 80 and rep.energy < 1e-5, path.stem
+                seen += 1
+    assert seen >= 6          # P, Neovius, I-WP, Wei, S'-S'' and its deformation
+
+
 @pytest.mark.parametrize("name", sorted(CELL_EULER))
 def test_patches_weld_into_a_closed_surface_of_the_published_genus(name):
     doc, report = _evaluated(EXAMPLES_DIR / f"{name}.json")
