@@ -6,12 +6,13 @@ paper's design process (section 3.3): Vertex nodes on the fundamental
 bounding volume (FBV), Edge Chains tracing the fundamental patch's boundary
 (smooth where it slides, straight where it is a fixed straight line), a
 Surface node whose ``type`` picks the solver, Mirror / Transform / Group
-nodes that fill the periodic unit cell [0, 1]^3 (the Object node wraps
+nodes that fill the periodic cell (the unit cube, or the Object node's box
+``cell`` for tetragonal and hexagonal structures; the Object node wraps
 geometry across the cell faces), an Object node that thickens the shell and
 one Voxel node with the base material of section 8.2.
 
-The Table 2 surfaces are exact minimal surfaces whose area per cell is
-published; the Table 3 entries are hybrids whose figures are not part of
+The Table 2 surfaces are exact minimal surfaces (P, D and the gyroid with
+published areas per cell); the Table 3 entries are hybrids whose figures are not part of
 the paper's text, so their graphs are our reading of the name and the node
 statistics of Table 4 (each description says what was chosen).
 
