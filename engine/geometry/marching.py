@@ -120,7 +120,10 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None
     verts = (verts.astype(np.float64) - pad) * spacing
     faces = faces.astype(np.int64)
     if closed:
-        verts = np.clip(verts, 0.0, extent)
+        # the last node plane times the spacing can miss the box face by an
+        # ulp (L / n * n != L); put it exactly on the face, where the welding
+        # below recognises the box edges
+        verts = np.where(np.abs(verts - extent) <= 1e-12 * extent, extent, np.clip(verts, 0.0, extent))
         verts, faces = weld_clipped(verts, faces, extent)
         verts, faces = drop_specks(verts, faces, 0.5 * float(np.prod(spacing)))
     return verts, faces

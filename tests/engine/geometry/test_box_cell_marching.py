@@ -61,3 +61,20 @@ def test_cell_none_is_the_unit_cube_bit_for_bit():
 def test_bad_cell_is_refused():
     with pytest.raises(ValueError, match="cell"):
         periodic_mesh(_strut_field((8, 8, 8)), cell=(1, 0, 1))
+
+
+def test_box_edges_weld_where_the_last_node_plane_misses_the_face_by_an_ulp():
+    # A strut along y in the plane z = 0 of the box (1, 1.732051, 0.8) (the
+    # hexagonal cell as typed) crosses the box edge y = Ly, z = 0; there its
+    # caps on the y and z faces meet. With 48 nodes, Ly / 48 * 48 misses Ly by
+    # an ulp. Merging vertices by position (what an STL reader does) must
+    # leave every edge on two faces.
+    box, shape = (1.0, 1.732051, 0.8), (28, 48, 22)
+    assert box[1] / 48 * 48 != box[1]
+    field = line_sdf_grid([[[0.5, 0.0, 0.0], [0.5, box[1], 0.0]]], [0.12], resolution=shape, cell=box)
+    v, f = periodic_mesh(field, cell=box)
+    _, merged = np.unique(np.round(v, 9), axis=0, return_inverse=True)
+    faces = merged.ravel()[f]
+    edges = np.sort(np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    _, uses = np.unique(edges, axis=0, return_counts=True)
+    assert np.all(uses == 2)
