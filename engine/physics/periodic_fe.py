@@ -133,7 +133,9 @@ def check_common(E, nu, void_modulus, tol, max_iterations, threads, memory_limit
 
 
 def check_density(density, name, ndim):
-    """Array of floats in [0, 1] with at least one solid cell; returns float64 copy."""
+    """Array of numbers in [0, 1] with at least one solid cell; returned as
+    given (no copy): `homogenize_grid` makes its float64 copy once the
+    memory check has passed."""
     try:
         arr = np.asarray(density)
     except Exception as exc:   # noqa: BLE001 - ragged lists etc.
@@ -147,10 +149,11 @@ def check_density(density, name, ndim):
         raise ValueError(f"{name} must be a {ndim}D array; got shape {arr.shape}")
     if min(arr.shape) < 2:
         raise ValueError(f"{name} needs at least 2 cells per axis; got shape {arr.shape}")
-    arr = arr.astype(np.float64)
-    if not np.all(np.isfinite(arr)):
+    # min / max propagate NaN and show infinities, so the grid is checked
+    # without a float64 copy (a refused or too-large grid allocates nothing)
+    lo, hi = float(arr.min()), float(arr.max())
+    if not (np.isfinite(lo) and np.isfinite(hi)):
         raise ValueError(f"{name} contains NaN or infinite values")
-    lo, hi = arr.min(), arr.max()
     if lo < 0.0 or hi > 1.0:
         raise ValueError(f"{name} values must lie in [0, 1]; got range [{lo:g}, {hi:g}]")
     if hi == 0.0:
@@ -182,12 +185,18 @@ def estimate_memory(density, void_modulus=0.0):
     Galerkin matrices; calibrated on measured peaks (see the bench).
     """
     dim = density.ndim
-    elem = density > 0 if void_modulus == 0 else np.ones(density.shape, dtype=bool)
-    n_elem = int(elem.sum())
+    n_elem = int(np.count_nonzero(density)) if void_modulus == 0 else density.size
+    if n_elem == density.size:       # every node is active: no masks needed
+        return _memory_for(dim, n_elem, n_elem, density.size)
+    elem = density > 0
     node = elem.copy()
     for a in range(dim):
         node |= np.roll(node, 1, axis=a)
-    n_nodes = int(node.sum())
+    return _memory_for(dim, n_elem, int(node.sum()), density.size)
+
+
+def _memory_for(dim, n_elem, n_nodes, size):
+    """The estimate of `estimate_memory` from the element and node counts."""
     nv = 6 if dim == 3 else 3
     vec = n_nodes * dim * nv * 8
     # Fine vectors: 7 float64 (CG x r z p q, loads, K u) and the float32
@@ -198,7 +207,7 @@ def estimate_memory(density, void_modulus=0.0):
     # 0.79 / 0.69 GB, 2D 400^2 0.31 / 0.31 GB (incl. ~0.2 GB of Python).
     nde = 2 ** dim * dim
     per_elem = 100 + nde * nde * 8 * 1.3 / 2 ** dim
-    return int(12 * vec + n_elem * per_elem + density.size * 24 + 200e6)
+    return int(12 * vec + n_elem * per_elem + size * 24 + 200e6)
 
 
 # --------------------------------------------------------------------- driver
@@ -229,13 +238,20 @@ def homogenize_grid(density, *, E, nu, void_modulus, tol, max_iterations, progre
     """
     t_start = time.perf_counter()
     dim = density.ndim
-    need = estimate_memory(density, void_modulus)
     limit = memory_limit if memory_limit is not None else _limit_from_machine()
-    if limit is not None and need > limit:
-        raise MemoryError(
-            f"homogenizing a {'x'.join(map(str, density.shape))} grid needs about "
-            f"{need / 1e9:.1f} GB, more than the {limit / 1e9:.1f} GB allowed; "
-            f"use a coarser grid")
+    if limit is not None:
+        # nodes >= elements on a periodic grid: a lower bound that needs no
+        # masks refuses a huge grid before the exact count allocates them
+        n_elem = int(np.count_nonzero(density)) if void_modulus == 0 else density.size
+        need = _memory_for(dim, n_elem, n_elem, density.size)
+        if need <= limit:
+            need = estimate_memory(density, void_modulus)
+        if need > limit:
+            raise MemoryError(
+                f"homogenizing a {'x'.join(map(str, density.shape))} grid needs about "
+                f"{need / 1e9:.1f} GB, more than the {limit / 1e9:.1f} GB allowed; "
+                f"use a coarser grid")
+    density = np.array(density, dtype=np.float64)      # the kernel's own copy
     ticker = _Ticker(progress)
     ticker(force=True)
 
