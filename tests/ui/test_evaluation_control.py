@@ -4,39 +4,55 @@ from __future__ import annotations
 
 import pytest
 
-import time
-
 from PySide6 import QtCore
 
 from engine.graph import SetParam
+from engine.graph.node import EvalContext
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 
-def test_cancel_slow_evaluation_keeps_window_responsive(window, qtbot, slow_graph, wait_eval):
+@pytest.fixture
+def progress_checks(monkeypatch):
+    """Counts the kernels' progress checks (EvalContext.progress calls) made
+    after the evaluation was cancelled (those that answered "stop")."""
+    seen = {"all": 0, "after_cancel": 0}
+    original = EvalContext.progress
+
+    def counted(self, done, total):
+        go_on = original(self, done, total)
+        seen["all"] += 1
+        seen["after_cancel"] += not go_on
+        return go_on
+
+    monkeypatch.setattr(EvalContext, "progress", counted)
+    return seen
+
+
+def test_cancel_slow_evaluation_keeps_window_responsive(window, qtbot, slow_graph, wait_eval,
+                                                       progress_checks):
     # Warm up first: numba compiles the kernels on first use and holds the GIL meanwhile.
     ids = slow_graph(window.undo, resolution=16)
     wait_eval(window, 0)
     window.act_auto.setChecked(False)
     window.undo.push(SetParam(ids["obj"], "resolution", 256))
     assert window.evaluation_idle                         # auto-evaluate off: nothing scheduled
-    ticks = []                                            # the GUI thread keeps processing events
+    beats = {"running": 0}                                # GUI heartbeats while the worker runs
     timer = QtCore.QTimer()
-    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.timeout.connect(lambda: beats.update(running=beats["running"] + window.worker.is_running))
     timer.start(20)
     window.evaluate_now()
     assert window.worker.is_running
     assert window.cancel_button.isEnabled()
     # cancel while the Object node computes its distance field (it reports progress)
     qtbot.waitUntil(lambda: window.progress.format().startswith(ids["obj"]), timeout=60000)
-    qtbot.wait(150)
+    qtbot.waitUntil(lambda: beats["running"] >= 5, timeout=60000)
     assert window.worker.is_running, "the slow graph finished before it could be cancelled"
-    t0 = time.perf_counter()
     qtbot.mouseClick(window.cancel_button, QtCore.Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: window.evaluation_idle, timeout=5000)
-    latency = time.perf_counter() - t0
+    qtbot.waitUntil(lambda: window.evaluation_idle, timeout=60000)   # generous; counts below
     timer.stop()
-    assert latency < 1.0
+    # the kernel stopped at the first progress check that saw the cancel
+    assert progress_checks["after_cancel"] <= 1, progress_checks
     report = window.last_report
     assert report.cancelled
     assert report.results[ids["obj"]].status == "cancelled"
@@ -44,8 +60,7 @@ def test_cancel_slow_evaluation_keeps_window_responsive(window, qtbot, slow_grap
     assert not window.cancel_button.isEnabled()
     # Kernels hold the GIL in stretches (numba without nogil, big numpy reductions), so
     # the event loop runs less often than the 20 ms timer asks; it must still run.
-    assert len(ticks) >= 3
-    assert max(b - a for a, b in zip(ticks, ticks[1:])) < 1.0
+    assert beats["running"] >= 5
 
 
 def test_newer_edit_supersedes_running_evaluation(window, qtbot, slow_graph, wait_eval):
@@ -75,13 +90,13 @@ def test_debounce_merges_quick_edits(window, qtbot, strut_graph, wait_eval):
     assert window.current_solid().resolution == 20
 
 
-def test_closing_during_evaluation_stops_the_worker(make_window, qtbot, slow_graph):
+def test_closing_during_evaluation_stops_the_worker(make_window, qtbot, slow_graph, progress_checks):
     window = make_window()
     window.act_auto.setChecked(False)
     ids = slow_graph(window.undo, resolution=256)
     window.evaluate_now()
     qtbot.waitUntil(lambda: window.progress.format().startswith(ids["obj"]), timeout=60000)
-    t0 = time.perf_counter()
     assert window.close()                                 # the prompter discards the changes
-    assert time.perf_counter() - t0 < 3.0
+    # closing cancelled the evaluation at its next progress check; it did not wait it out
+    assert progress_checks["after_cancel"] <= 1, progress_checks
     assert not window.worker.is_busy and window.viewport._closed

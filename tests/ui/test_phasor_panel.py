@@ -421,10 +421,10 @@ def test_a_slow_slice_shows_progress_and_can_be_cancelled(qtbot, make_panel):
     panel.worker.request(SliceJob("diamonds", panel.plane, g.infill, prepare=slow, view=panel.view_id))
     qtbot.waitUntil(lambda: panel.progress_row.isVisible(), timeout=3000)
     assert len(calls) >= 20        # shown only after ~0.3 s
-    t0 = time.perf_counter()
+    at_click = len(calls)
     qtbot.mouseClick(panel.cancel_button, QtCore.Qt.MouseButton.LeftButton)
-    assert panel.worker.wait_idle(2000)
-    assert time.perf_counter() - t0 < 1.0
+    assert panel.worker.wait_idle(30000)          # a generous bound; the count below is the test
+    assert len(calls) - at_click <= 2, len(calls) - at_click   # stopped at its next progress check
     qtbot.waitUntil(lambda: not panel.progress_row.isVisible(), timeout=1000)
     assert "cancelled" in panel.status.text()
 

@@ -52,23 +52,31 @@ class _Fail(NodeType):
         return {"value": inputs["x"]}
 
 
+# What the slow node saw: its progress checks, and those made after the test
+# asked for a cancel (set SLOW["cancel_requested"] just before cancelling).
+SLOW: dict = {}
+
+
 @register
 class _Slow(NodeType):
+    """Makes `steps` progress checks, 10 ms apart; counts them in SLOW."""
+
     type_name = "_TestSlow"
     code = "slow"
     outputs = (Port("value", "Field"),)
-    params = (Param("seconds", "float", 5.0, 0.0, 60.0),)
+    params = (Param("steps", "int", 500, 1, 100_000),)
 
     def evaluate(self, inputs, params, ctx):
         CALLS[ctx.node_id] += 1
-        t0 = time.perf_counter()
-        steps = 0
-        while time.perf_counter() - t0 < params["seconds"]:
+        SLOW.update(checks=0, checks_after_cancel=0)
+        for step in range(params["steps"]):
             time.sleep(0.01)
-            steps += 1
-            if not ctx.progress(time.perf_counter() - t0, params["seconds"]):
+            SLOW["checks"] += 1
+            if SLOW.get("cancel_requested"):
+                SLOW["checks_after_cancel"] += 1
+            if not ctx.progress(step + 1, params["steps"]):
                 ctx.check()
-        return {"value": float(steps)}
+        return {"value": float(params["steps"])}
 
 
 @register
