@@ -16,6 +16,9 @@
 * :mod:`.dual_contour` -- the dual polygon of a conjugate loop;
 * :mod:`.cscm` -- conjugate surface construction with edge-length
   optimisation (free-boundary patches);
+* :mod:`.cscm_starts` -- the starts of its search and the choice between
+  solutions (least area);
+* :mod:`.fix_boundary` -- FIXBOUNDARY: snapping a patch onto its planes;
 * :mod:`.associate` -- associate family members and their periods;
 * :mod:`.tiling` -- extending a patch by mirrors and half-turns;
 * :mod:`.thickness_profile` -- thickness spread from sparse samples.

@@ -9,6 +9,12 @@ problem, conjugates (:mod:`.conjugate`), turns the result by a rotation R
 fitted once, and measures how well the boundary arcs lie on their planes.
 Nelder-Mead searches the lengths in ratio space.
 
+The energy can vanish at more than one patch (in the cube, Schwarz P and a
+tetragonal tP member), so the search runs from the user's start and from a
+canonical one and keeps the least-area solution (:mod:`.cscm_starts`):
+the patch depends on the FBV and the loop's combinatorics, not on where
+the vertices sit on their edges (paper Fig. 8).
+
 Choices made here, where the paper leaves room:
 
 * Ratio space is searched on the subspace of ratio changes that keep the
@@ -36,9 +42,9 @@ Choices made here, where the paper leaves room:
   plane normals, the exact R is the identity; a fitted R within
   ``ROTATION_SNAP_DEG`` of it is replaced by the identity (its ~0.1 degree
   of discretisation noise would bias the optimum by ~0.5%).
-* FIXBOUNDARY: the thin-shell direct solver is not used; boundary vertices
-  are projected onto their plane (corners onto their FBV edge) and the
-  interior follows by a harmonic (cotan) extension of those displacements.
+* FIXBOUNDARY (:mod:`.fix_boundary`): boundary vertices are projected onto
+  their plane (corners onto their FBV edge) and the interior follows by a
+  harmonic (cotan) extension of those displacements.
 """
 
 from __future__ import annotations
@@ -53,9 +59,11 @@ from scipy.sparse.linalg import splu
 
 from ..cancel import report
 from .conjugate import conjugate_surface
-from .curvature import cotan_laplacian, surface_report
+from .cscm_starts import choose_run, search_starts
+from .curvature import cotan_laplacian, surface_area, surface_report
 from .dual_contour import ContourError, close_lengths, dual_directions, initial_lengths
 from .fbv import check_conjugate_loop, vertex_frames
+from .fix_boundary import fix_boundary
 from .plateau import relax_plateau, solve_plateau
 
 __all__ = ["ConjugatePatch", "conjugate_surface_construction", "RATIO_BOUNDS"]
@@ -99,8 +107,13 @@ class ConjugatePatch:
     lengths : (k,) float64, read-only
         Optimised dual edge lengths (model units of the dual).
     report : dict
-        ``iterations`` and ``evaluations`` of Nelder-Mead, ``energy`` (final)
-        and ``initial_energy``, ``energy_history``, ``converged``,
+        ``iterations`` and ``evaluations`` of Nelder-Mead in the search whose
+        patch was kept (``start``: ``'user'`` or ``'canonical'``), summed
+        over all starts in ``iterations_total`` / ``evaluations_total``,
+        ``starts`` (one dict per search: name, initial and final lengths,
+        energies, area, iterations, evaluations, converged), ``energy``
+        (final, of the kept search) and ``initial_energy`` (at the user's
+        start), ``energy_history`` (of the kept search), ``converged``,
         ``dimensions``, ``rotation`` (3x3 list), ``conjugate_sign``,
         ``scale``, ``snap_max`` (largest snap distance), ``area``,
         ``max_abs_H`` / ``mean_abs_H`` (1/model units), ``seconds`` and
@@ -308,10 +321,11 @@ class _ContourEnergy:
     """CONTOURENERGY (Algorithm 2) for one loop, with its cached pieces."""
 
     def __init__(self, fbv, loop, directions, base, energy_kind, progress, *,
-                 resolution=SEARCH_RESOLUTION, steps=SEARCH_STEPS, anchor=None, previous=None):
+                 resolution=SEARCH_RESOLUTION, steps=SEARCH_STEPS, anchor=None, frame=None,
+                 history=None):
         self.fbv, self.loop, self.dirs, self.base = fbv, loop, directions, base
         self.kind = energy_kind
-        self.progress = progress
+        self.progress, self.resolution = progress, resolution
         anchor = base if anchor is None else anchor
         self.family = _DualFamily(self.corners(anchor), resolution=resolution, steps=steps,
                                   progress=progress)
@@ -319,14 +333,11 @@ class _ContourEnergy:
         self.groups = _plane_groups(loop.arc_planes, fam.edge, fam.source, fbv.n_planes)
         self.vgroups = [fam.boundary[g] for g in self.groups]
         self.pairs = _aabb_pairs(fbv, self.vgroups) if energy_kind == "aabb" else None
-        if previous is None:
-            self.rotation, self.sign, self.rotation_residual = self._fit_rotation()
-            self.history = []
-        else:
-            self.rotation, self.sign = previous.rotation, previous.sign
-            self.rotation_residual = previous.rotation_residual
-            self.fitted_angle = previous.fitted_angle
-            self.history = previous.history
+        # The frame (R, conjugate sign, fit residual, fitted angle) is fitted
+        # once, on the first start's test patch, and shared by every search.
+        self.frame = self._fit_rotation() if frame is None else frame
+        self.rotation, self.sign, self.rotation_residual, self.fitted_angle = self.frame
+        self.history = [] if history is None else history
 
     def corners(self, lengths):
         steps = lengths[:, None] * self.dirs
@@ -346,11 +357,10 @@ class _ContourEnergy:
             if best is None or resid < best[2] - 1e-12:
                 best = (r, sign, resid)
         r, sign, resid = best
-        self.fitted_angle = math.degrees(math.acos(float(np.clip((np.trace(r) - 1.0) / 2.0,
-                                                                 -1.0, 1.0))))
-        if self.fitted_angle <= ROTATION_SNAP_DEG:
+        angle = math.degrees(math.acos(float(np.clip((np.trace(r) - 1.0) / 2.0, -1.0, 1.0))))
+        if angle <= ROTATION_SNAP_DEG:
             r = np.eye(3)
-        return r, sign, resid
+        return r, sign, resid, angle
 
     def lengths(self, ratios):
         lo, hi = RATIO_BOUNDS
@@ -363,6 +373,24 @@ class _ContourEnergy:
         dual = fam.realise(self.corners(lengths))
         conj = conjugate_surface(dual, fam.faces, sign=self.sign)
         return conj.vertices @ self.rotation.T, conj
+
+    def area(self, lengths):
+        """Area of the primary patch at ``lengths``, scaled to the FBV (not counted).
+
+        The dual is solved afresh rather than warm-started, so the area
+        carries no bias from where the dual meshes were anchored.
+        """
+        corners = self.corners(lengths)
+        sol = solve_plateau(corners, edge_length=float(lengths.sum()) / self.resolution,
+                            tol=1e-6, max_iter=40,
+                            progress=self.progress.poll if self.progress else None)
+        faces, boundary, source = np.array(sol.faces), np.array(sol.boundary), np.array(sol.source)
+        q = conjugate_surface(sol.vertices, faces, sign=self.sign).vertices @ self.rotation.T
+        edge, _ = _boundary_layout(source, corners.shape[0])
+        groups = _plane_groups(self.loop.arc_planes, edge, source, self.fbv.n_planes)
+        s, _, _ = _fit_similarity([q[boundary[g]] for g in groups], self.fbv.normals,
+                                  self.fbv.offsets)
+        return s * s * surface_area(q, faces)
 
     def __call__(self, ratios):
         closed, ok = self.lengths(ratios)
@@ -391,8 +419,7 @@ def _energy_kind(fbv, loop, energy):
 def conjugate_surface_construction(fbv, loop_points, *, energy="auto", max_iter=80,
                                    xatol=1e-4, fatol=1e-10, search_resolution=SEARCH_RESOLUTION,
                                    final_resolution=FINAL_RESOLUTION, search_steps=SEARCH_STEPS,
-                                   initial=None,
-                                   progress=None):
+                                   initial=None, restart=True, progress=None):
     """Free-boundary minimal patch in an FBV by the conjugate surface method.
 
     Parameters
@@ -416,10 +443,14 @@ def conjugate_surface_construction(fbv, loop_points, *, energy="auto", max_iter=
         Pinkall-Polthier steps after each warm start during the search.
     initial : (k,) float, optional
         Initial dual lengths instead of the section 4.2.4 heuristic.
+    restart : bool
+        Also search from the canonical start and keep the least-area
+        solution (:mod:`.cscm_starts`); False searches from the user's
+        start only.
     progress : callable, optional
         ``progress(done, total) -> bool``, called per energy evaluation
-        (``total`` estimates two per Nelder-Mead iteration) and per
-        Plateau step; False cancels
+        (``total`` estimates two per Nelder-Mead iteration and start) and
+        per Plateau step; False cancels
         (:class:`~engine.geometry.cancel.Cancelled`).
 
     Returns
@@ -442,50 +473,43 @@ def conjugate_surface_construction(fbv, loop_points, *, energy="auto", max_iter=
             raise ValueError(f"{name} must be an integer >= 8; got {value!r}")
     loop = check_conjugate_loop(fbv, loop_points)
     kind = _energy_kind(fbv, loop, energy)
-    bar = _Progress(progress, 2 * max_iter + 8) if progress is not None else None
     v_angles, v_normals = vertex_frames(fbv, loop)
     dirs = dual_directions(v_angles, v_normals)
     l_init = initial_lengths(fbv, loop) if initial is None else np.asarray(initial, float).ravel()
     if l_init.shape != (loop.points.shape[0],) or np.any(~(l_init > 0.0)):
         raise ValueError(f"initial must hold {loop.points.shape[0]} positive lengths; got {l_init}")
-    base, ok = close_lengths(l_init, dirs)
-    if not ok:
-        base = _positive_closure(l_init, dirs)
-    basis = _reduced_basis(base, dirs)
-    objective, ratios, nit, converged, e0 = None, np.ones(base.size), 0, True, None
-    stage_iterations, final_energy = [], None
+    starts = search_starts(fbv, loop, l_init, canonical=restart)
+    bar = _Progress(progress, len(starts) * (2 * max_iter + 4) + 4) if progress is not None \
+        else None
+    options = {"max_iter": max_iter, "xatol": xatol, "fatol": fatol,
+               "resolution": search_resolution, "steps": search_steps}
     t_search = time.perf_counter()
-    for stage, (resolution, step) in enumerate(((search_resolution, 0.1),
-                                               (search_resolution, REFINE_SIMPLEX))):
-        # Stage 2 re-anchors the dual meshes at the stage-1 optimum, removing
-        # the bias of warm starts far from the reference contour.
-        objective = _ContourEnergy(fbv, loop, dirs, base, kind, bar,
-                                   resolution=resolution, steps=search_steps,
-                                   anchor=objective.lengths(ratios)[0] if stage else None,
-                                   previous=objective)
-        if e0 is None:
-            e0 = final_energy = objective(ratios)
-        if not (basis.shape[1] and max_iter - nit > 0):
-            break
-        res = _nelder_mead(objective, ratios, basis, step, max_iter - nit,
-                           xatol if stage else 10.0 * xatol, fatol if stage else max(fatol, STAGE1_FATOL))
-        ratios = ratios + basis @ res.x
-        nit += int(res.nit)
-        stage_iterations.append(int(res.nit))
-        converged = bool(res.success)
-        final_energy = float(res.fun)
-    lengths, _ = objective.lengths(ratios)
+    runs = [_search(fbv, loop, dirs, kind, starts[0], bar, None, **options)]
+    for start in starts[1:] if runs[0].dimensions else ():   # nothing to search: one start
+        try:
+            runs.append(_search(fbv, loop, dirs, kind, start, bar, runs[0].objective.frame,
+                                **options))
+        except ContourError:
+            continue                 # the user's loop closes; a start that cannot is dropped
+    if len(runs) > 1:
+        for r in runs:
+            r.area = r.objective.area(r.lengths)
+    chosen = runs[choose_run([r.energy for r in runs], [r.area for r in runs])]
+    objective = chosen.objective
     t_final = time.perf_counter()
-    patch = _final_patch(objective, lengths, final_resolution, bar)
+    patch = _final_patch(objective, chosen.lengths, final_resolution, bar)
     if bar is not None:
         bar.finish()
     seconds = time.perf_counter() - t0
     patch.report.update({
-        "iterations": nit, "stage_iterations": stage_iterations,
-        "evaluations": len(objective.history), "converged": converged,
-        "dimensions": int(basis.shape[1]), "initial_energy": float(e0),
-        "energy": float(final_energy),
+        "iterations": chosen.iterations, "stage_iterations": chosen.stage_iterations,
+        "evaluations": len(objective.history), "converged": chosen.converged,
+        "dimensions": chosen.dimensions, "initial_energy": runs[0].initial_energy,
+        "energy": chosen.energy,
         "energy_history": list(objective.history), "energy_kind": kind,
+        "start": chosen.name, "starts": [r.summary() for r in runs],
+        "iterations_total": sum(r.iterations for r in runs),
+        "evaluations_total": sum(len(r.objective.history) for r in runs),
         "rotation": objective.rotation.tolist(), "conjugate_sign": objective.sign,
         "rotation_residual": objective.rotation_residual,
         "fitted_rotation_deg": objective.fitted_angle,
@@ -493,6 +517,65 @@ def conjugate_surface_construction(fbv, loop_points, *, energy="auto", max_iter=
         "seconds": seconds, "seconds_search": t_final - t_search,
         "seconds_final": time.perf_counter() - t_final})
     return patch
+
+
+@dataclass
+class _Run:
+    """One search (both stages) from one start."""
+
+    name: str
+    initial_lengths: np.ndarray
+    objective: _ContourEnergy
+    lengths: np.ndarray
+    initial_energy: float
+    energy: float
+    iterations: int
+    stage_iterations: list
+    converged: bool
+    dimensions: int
+    area: float = float("nan")             # set only when several runs compete
+
+    def summary(self):
+        return {"name": self.name, "initial_lengths": self.initial_lengths.tolist(),
+                "lengths": self.lengths.tolist(), "initial_energy": self.initial_energy,
+                "energy": self.energy, "area": self.area, "iterations": self.iterations,
+                "stage_iterations": list(self.stage_iterations),
+                "evaluations": len(self.objective.history), "converged": self.converged}
+
+
+def _search(fbv, loop, dirs, kind, start, bar, frame, *, max_iter, xatol, fatol, resolution,
+            steps):
+    """Nelder-Mead in two stages from ``start``; ``frame`` None fits R here."""
+    base, ok = close_lengths(start.lengths, dirs)
+    if not ok:
+        base = _positive_closure(start.lengths, dirs)
+    basis = _reduced_basis(base, dirs)
+    objective, ratios, nit, converged, e0 = None, np.ones(base.size), 0, True, None
+    stage_iterations, final_energy = [], None
+    for stage, step in enumerate((0.1, REFINE_SIMPLEX)):
+        # Stage 2 re-anchors the dual meshes at the stage-1 optimum, removing
+        # the bias of warm starts far from the reference contour.
+        objective = _ContourEnergy(fbv, loop, dirs, base, kind, bar, resolution=resolution,
+                                   steps=steps,
+                                   anchor=objective.lengths(ratios)[0] if stage else None,
+                                   frame=objective.frame if stage else frame,
+                                   history=objective.history if stage else None)
+        if e0 is None:
+            e0 = final_energy = objective(ratios)
+        if not (basis.shape[1] and max_iter - nit > 0):
+            break
+        res = _nelder_mead(objective, ratios, basis, step, max_iter - nit,
+                           xatol if stage else 10.0 * xatol,
+                           fatol if stage else max(fatol, STAGE1_FATOL))
+        ratios = ratios + basis @ res.x
+        nit += int(res.nit)
+        stage_iterations.append(int(res.nit))
+        converged = bool(res.success)
+        final_energy = float(res.fun)
+    lengths, _ = objective.lengths(ratios)
+    return _Run(start.name, np.asarray(start.lengths, dtype=np.float64), objective, lengths,
+                float(e0), float(final_energy), nit, stage_iterations, converged,
+                int(basis.shape[1]))
 
 
 def _nelder_mead(objective, ratios, basis, step, max_iter, xatol, fatol):
@@ -522,17 +605,6 @@ def _positive_closure(l_init, dirs):
 
 # ---------------------------------------------------------- post-processing
 
-def _snap_targets(q, planes, fbv):
-    """Project each point onto its one or two planes."""
-    out = q.copy()
-    for k, (a, b) in enumerate(planes):
-        ks = [a] if b < 0 else [a, b]
-        n = fbv.normals[ks]
-        h = fbv.offsets[ks]
-        out[k] = q[k] - n.T @ np.linalg.solve(n @ n.T, n @ q[k] - h)
-    return out
-
-
 def _final_patch(objective, lengths, resolution, bar):
     fbv, loop = objective.fbv, objective.loop
     corners = objective.corners(lengths)
@@ -551,14 +623,11 @@ def _final_patch(objective, lengths, resolution, bar):
     planes[:, 0] = loop.arc_planes[edge]
     at_corner = source >= 0
     planes[at_corner, 1] = loop.arc_planes[(edge[at_corner] - 1) % n]
-    target = _snap_targets(q[boundary], planes, fbv)
-    shift = target - q[boundary]
-    q = _harmonic_shift(q, faces, boundary, shift)
-    q[boundary] = target
+    q, snap_max = fix_boundary(q, faces, boundary, planes, fbv)
     corner_idx = np.empty(n, dtype=np.int64)
     corner_idx[source[at_corner]] = boundary[at_corner]
     stats = surface_report(q, faces, boundary)
-    rep = {"scale": s, "snap_max": float(np.linalg.norm(shift, axis=1).max()),
+    rep = {"scale": s, "snap_max": snap_max,
            "closure_error": conj.closure_error * s, "area": stats["area"],
            "max_abs_H": stats["max_abs_H"], "mean_abs_H": stats["mean_abs_H"],
            "plateau_iterations": list(sol.iterations)}
@@ -566,17 +635,3 @@ def _final_patch(objective, lengths, resolution, bar):
         arr.setflags(write=False)
     return ConjugatePatch(vertices=q, faces=faces, boundary=boundary, corners=corner_idx,
                           boundary_planes=planes, lengths=lengths, report=rep)
-
-
-def _harmonic_shift(v, faces, boundary, shift):
-    """Interior displacement: cotan-harmonic extension of a boundary one."""
-    n = v.shape[0]
-    fixed = np.zeros(n, dtype=bool)
-    fixed[boundary] = True
-    free = np.flatnonzero(~fixed)
-    out = v.copy()
-    if free.size:
-        lap = cotan_laplacian(v, faces).tocsc()
-        rhs = lap[free][:, boundary] @ shift
-        out[free] += splu((-lap[free][:, free]).tocsc()).solve(np.ascontiguousarray(rhs))
-    return out
