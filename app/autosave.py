@@ -12,12 +12,14 @@ file, so the next start can offer to recover them.
 from __future__ import annotations
 
 import json
+import math
 import os
 import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
+from engine.fileio import remove_stale_temps
 from engine.graph import GraphDocument, load_project, save_project, write_atomic
 
 ENV_VAR = "MESOFORGE_AUTOSAVE_DIR"
@@ -44,7 +46,7 @@ def pid_alive(pid: int) -> bool:
         return False
     except PermissionError:  # exists, owned by someone else
         return True
-    except OSError:
+    except (OSError, OverflowError):  # OverflowError: no process id is that large
         return False
     return True
 
@@ -94,7 +96,9 @@ class AutosaveManager:
     def save(self, doc: GraphDocument, project_path: str | os.PathLike | None) -> Path:
         """Write `doc` atomically (document first, then its sidecar), as a
         project file with the stateful nodes' results in ``doc.node_state``
-        (the window puts ``Evaluator.export_state()`` there first)."""
+        (the window puts ``Evaluator.export_state()`` there first).  A new
+        autosave folder is private to the user (0700)."""
+        self.directory.mkdir(mode=0o700, parents=True, exist_ok=True)
         save_project(doc, self.autosave_path)
         now = time.time()
         meta = {
@@ -109,11 +113,7 @@ class AutosaveManager:
 
     def clear(self) -> None:
         """Remove this session's autosave (after a clean save or exit)."""
-        for p in (self.meta_path, self.autosave_path):
-            try:
-                p.unlink()
-            except FileNotFoundError:
-                pass
+        _remove_quietly(self.meta_path, self.autosave_path)
         self.last_saved_at = None
 
     # -- recovery ---------------------------------------------------------
@@ -132,7 +132,7 @@ class AutosaveManager:
                 try:
                     if os.path.getmtime(item.original_path) >= item.saved_at:
                         continue  # the project was saved after this autosave: nothing to recover
-                except OSError:
+                except (OSError, ValueError):  # ValueError: a path with a NUL byte
                     pass  # the original is gone: the autosave is all there is
             items.append(item)
         items.sort(key=lambda it: it.saved_at, reverse=True)
@@ -145,11 +145,23 @@ class AutosaveManager:
 
     @staticmethod
     def discard(item: RecoveryItem) -> None:
+        """Remove a recoverable autosave, its sidecar and the temporary files a
+        save killed midway left of them.  Best effort: never raises."""
+        _remove_quietly(item.meta_path, item.autosave_path)
         for p in (item.meta_path, item.autosave_path):
             try:
-                p.unlink()
-            except FileNotFoundError:
+                remove_stale_temps(p)
+            except OSError:
                 pass
+
+
+def _remove_quietly(*paths: Path) -> None:
+    """Unlink what exists; a file that cannot be removed stays (and is retried next time)."""
+    for p in paths:
+        try:
+            p.unlink()
+        except OSError:
+            pass
 
 
 def _read_meta(meta_path: Path) -> RecoveryItem | None:
@@ -157,15 +169,24 @@ def _read_meta(meta_path: Path) -> RecoveryItem | None:
     try:
         meta = json.loads(meta_path.read_text(encoding="utf-8"))
         name = meta["autosave"]
-        if not isinstance(name, str) or "/" in name or "\\" in name:
+        if not _is_autosave_name(name):
             return None
         original = meta.get("original_path")
+        saved_at = float(meta["saved_at"])
+        if not math.isfinite(saved_at) or (original is not None and not isinstance(original, str)):
+            return None
         return RecoveryItem(
             autosave_path=meta_path.parent / name,
             meta_path=meta_path,
-            original_path=str(original) if original is not None else None,
-            saved_at=float(meta["saved_at"]),
+            original_path=original,
+            saved_at=saved_at,
             pid=int(meta["pid"]),
         )
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
+    except (OSError, ValueError, KeyError, TypeError, ArithmeticError, RecursionError):
+        return None  # RecursionError: JSON nested too deep; ArithmeticError: int(Infinity)
+
+
+def _is_autosave_name(name) -> bool:
+    """A plain file name of an autosave document in the same folder (no path, no sidecar)."""
+    return (isinstance(name, str) and name.endswith(DOC_SUFFIX) and not name.endswith(META_SUFFIX)
+            and not any(c in name for c in "/\\\0") and not name.startswith("."))

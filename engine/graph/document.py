@@ -9,9 +9,11 @@ refuse.  Views subscribe with `subscribe(callback)` and receive
 from __future__ import annotations
 
 import copy
+import heapq
+import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 from .errors import GraphError
 from .node import node_type
@@ -104,14 +106,16 @@ class GraphDocument:
 
     def downstream(self, node_id: str) -> set[str]:
         """All nodes reachable from `node_id` (excluding itself)."""
+        succ: dict[str, list[str]] = {}
+        for e in self.edges:
+            succ.setdefault(e.src, []).append(e.dst)
         seen: set[str] = set()
         stack = [node_id]
         while stack:
-            n = stack.pop()
-            for e in self.edges:
-                if e.src == n and e.dst not in seen:
-                    seen.add(e.dst)
-                    stack.append(e.dst)
+            for m in succ.get(stack.pop(), ()):
+                if m not in seen:
+                    seen.add(m)
+                    stack.append(m)
         return seen
 
     def topological_order(self) -> list[str]:
@@ -124,21 +128,22 @@ class GraphDocument:
     # -- raw mutators (commands call these) -----------------------------
     def _raw_add_node(self, node: NodeInstance, index: int | None = None) -> None:
         if not _ID_RE.match(node.id):
-            raise GraphError(f"node id {node.id!r} is not a valid identifier", node=node.id)
+            raise GraphError(f"node id {node.id!r} is not a valid identifier", node=node.id, where="id")
         if node.id in self.nodes:
-            raise GraphError(f"a node with id {node.id!r} already exists", node=node.id)
+            raise GraphError(f"a node with id {node.id!r} already exists", node=node.id, where="id")
         cls = node_type(node.type_name)
         node.params = cls.validate_params(node.params, node.id)
         if cls.max_per_graph is not None:
             same = [n for n, inst in self.nodes.items() if inst.type_name == node.type_name]
             if len(same) >= cls.max_per_graph:
                 raise GraphError(f"a graph holds at most {cls.max_per_graph} {node.type_name} node(s); "
-                                 f"it already has {same}", node=node.id)
-        items = list(self.nodes.items())
-        if index is None:
-            index = len(items)
-        items.insert(index, (node.id, node))
-        self.nodes = dict(items)
+                                 f"it already has {same}", node=node.id, where="type")
+        if index is None or index >= len(self.nodes):
+            self.nodes[node.id] = node  # appending keeps loading a project linear
+        else:
+            items = list(self.nodes.items())
+            items.insert(index, (node.id, node))
+            self.nodes = dict(items)
         self.emit("node_added", node.id)
 
     def _raw_remove_node(self, node_id: str) -> tuple[NodeInstance, int]:
@@ -153,6 +158,17 @@ class GraphDocument:
 
     def check_connection(self, edge: Edge) -> None:
         """Raise GraphError if `edge` may not be added; names node and port."""
+        in_port = self._connection_port(edge)
+        if edge in self.edges:
+            raise _already_connected(edge)
+        if not in_port.multi and self.inputs_of(edge.dst, edge.dst_port):
+            raise _input_taken(edge)
+        if edge.src == edge.dst or edge.src in self.downstream(edge.dst):
+            raise _cycle(edge)
+
+    def _connection_port(self, edge: Edge):
+        """The input port `edge` would feed; GraphError if a node or port is
+        missing or the port types do not match."""
         src = self.node(edge.src)
         dst = self.node(edge.dst)
         try:
@@ -168,15 +184,7 @@ class GraphDocument:
                 f"cannot connect {edge.src}.{edge.src_port} ({out_port.type}) to "
                 f"{edge.dst}.{edge.dst_port}, which takes {in_port.type}",
                 node=edge.dst, where=edge.dst_port)
-        if edge in self.edges:
-            raise GraphError(f"{edge.src}.{edge.src_port} is already connected to {edge.dst}.{edge.dst_port}",
-                             node=edge.dst, where=edge.dst_port)
-        if not in_port.multi and self.inputs_of(edge.dst, edge.dst_port):
-            raise GraphError(f"input {edge.dst}.{edge.dst_port} takes one connection and already has one",
-                             node=edge.dst, where=edge.dst_port)
-        if edge.src == edge.dst or edge.src in self.downstream(edge.dst):
-            raise GraphError(f"connecting {edge.src} to {edge.dst} would create a cycle",
-                             node=edge.dst, where=edge.dst_port)
+        return in_port
 
     def _raw_connect(self, edge: Edge, index: int | None = None) -> None:
         self.check_connection(edge)
@@ -185,6 +193,43 @@ class GraphDocument:
         else:
             self.edges.insert(index, edge)
         self.emit("edge_added", edge)
+
+    def _raw_connect_all(self, edges: Sequence[Edge]) -> None:
+        """Append `edges` in order, each checked as `check_connection` checks it
+        after the ones before it, in O(V + E) overall (loading a project).
+
+        All or nothing: when an edge is refused the document is unchanged and
+        the GraphError's ``index`` is that edge's position in `edges`.
+        """
+        present = set(self.edges)
+        taken = {(e.dst, e.dst_port) for e in self.edges}
+        accepted: list[Edge] = []
+        refused: GraphError | None = None
+        for i, edge in enumerate(edges):
+            try:
+                in_port = self._connection_port(edge)
+                if edge in present:
+                    raise _already_connected(edge)
+                if not in_port.multi and (edge.dst, edge.dst_port) in taken:
+                    raise _input_taken(edge)
+                if edge.src == edge.dst:
+                    raise _cycle(edge)
+            except GraphError as exc:
+                exc.index, refused = i, exc
+                break
+            present.add(edge)
+            taken.add((edge.dst, edge.dst_port))
+            accepted.append(edge)
+        closing = _first_cycle_closing(list(self.nodes), self.edges, accepted)
+        if closing is not None:
+            err = _cycle(accepted[closing])
+            err.index = closing
+            raise err
+        if refused is not None:
+            raise refused
+        for edge in accepted:
+            self.edges.append(edge)
+            self.emit("edge_added", edge)
 
     def _raw_disconnect(self, edge: Edge) -> int:
         try:
@@ -207,8 +252,12 @@ class GraphDocument:
 
     def _raw_move(self, node_id: str, position: tuple[float, float]) -> tuple[float, float]:
         node = self.node(node_id)
+        x, y = float(position[0]), float(position[1])
+        if not (math.isfinite(x) and math.isfinite(y)):  # a project file cannot hold it
+            raise GraphError(f"node {node_id!r}: editor position {position!r} is not two finite numbers",
+                             node=node_id, where="position")
         old = node.position
-        node.position = (float(position[0]), float(position[1]))
+        node.position = (x, y)
         self.emit("node_moved", node_id)
         return old
 
@@ -220,6 +269,8 @@ class GraphDocument:
         return old
 
     def _raw_set_seed(self, seed: int) -> int:
+        if int(seed) < 0:  # a project file holds non-negative seeds only
+            raise GraphError(f"seed {seed!r} is invalid: expected a non-negative integer", where="seed")
         old = self.seed
         self.seed = int(seed)
         self.emit("seed_changed", seed)
@@ -238,25 +289,81 @@ class GraphDocument:
 
 
 def topological_order(node_ids: list[str], edges) -> list[str]:
-    """Kahn's algorithm; ties broken by document order.  Raises on a cycle."""
+    """Kahn's algorithm; ties broken by document order.  Raises on a cycle.
+
+    O((V + E) log V): the ready nodes wait in a heap keyed on document position.
+    """
     position = {n: i for i, n in enumerate(node_ids)}
-    indeg = {n: 0 for n in node_ids}
+    indeg = dict.fromkeys(node_ids, 0)
     succ: dict[str, list[str]] = {n: [] for n in node_ids}
     for e in edges:
         if e.src in indeg and e.dst in indeg:
             indeg[e.dst] += 1
             succ[e.src].append(e.dst)
-    ready = sorted((n for n, d in indeg.items() if d == 0), key=position.get)
+    ready = [position[n] for n, d in indeg.items() if d == 0]
+    heapq.heapify(ready)
     out = []
     while ready:
-        n = ready.pop(0)
+        n = node_ids[heapq.heappop(ready)]
         out.append(n)
         for m in succ[n]:
             indeg[m] -= 1
             if indeg[m] == 0:
-                ready.append(m)
-        ready.sort(key=position.get)
+                heapq.heappush(ready, position[m])
     if len(out) != len(node_ids):
         stuck = sorted(set(node_ids) - set(out), key=position.get)
         raise GraphError(f"the graph has a cycle through nodes {stuck}", node=stuck[0])
     return out
+
+
+def _has_cycle(node_ids: list[str], edges: Sequence[Edge]) -> bool:
+    """Whether `edges` between `node_ids` close a directed cycle; O(V + E)."""
+    indeg = dict.fromkeys(node_ids, 0)
+    succ: dict[str, list[str]] = {}
+    for e in edges:
+        indeg[e.dst] += 1
+        succ.setdefault(e.src, []).append(e.dst)
+    ready = [n for n, d in indeg.items() if d == 0]
+    done = 0
+    while ready:
+        n = ready.pop()
+        done += 1
+        for m in succ.get(n, ()):
+            indeg[m] -= 1
+            if indeg[m] == 0:
+                ready.append(m)
+    return done != len(indeg)
+
+
+def _first_cycle_closing(node_ids: list[str], existing: list[Edge], added: list[Edge]) -> int | None:
+    """Index of the first edge of `added` that closes a cycle when they are
+    appended to the acyclic `existing` one by one, or None.
+
+    One O(V + E) check when there is no cycle (the usual case); a binary
+    search over prefixes, O((V + E) log E), when there is.
+    """
+    if not _has_cycle(node_ids, existing + added):
+        return None
+    lo, hi = 0, len(added) - 1  # the prefix ending at hi has a cycle
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if _has_cycle(node_ids, existing + added[: mid + 1]):
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
+def _already_connected(edge: Edge) -> GraphError:
+    return GraphError(f"{edge.src}.{edge.src_port} is already connected to {edge.dst}.{edge.dst_port}",
+                      node=edge.dst, where=edge.dst_port)
+
+
+def _input_taken(edge: Edge) -> GraphError:
+    return GraphError(f"input {edge.dst}.{edge.dst_port} takes one connection and already has one",
+                      node=edge.dst, where=edge.dst_port)
+
+
+def _cycle(edge: Edge) -> GraphError:
+    return GraphError(f"connecting {edge.src} to {edge.dst} would create a cycle",
+                      node=edge.dst, where=edge.dst_port)

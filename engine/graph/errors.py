@@ -6,10 +6,12 @@ from __future__ import annotations
 class GraphError(ValueError):
     """A refused edit or evaluation; `node` and `where` locate it."""
 
-    def __init__(self, message: str, *, node: str | None = None, where: str | None = None):
+    def __init__(self, message: str, *, node: str | None = None, where: str | None = None,
+                 index: int | None = None):
         super().__init__(message)
         self.node = node
         self.where = where
+        self.index = index  # position of the refused item in a bulk edit (`GraphDocument.load_parts`)
 
 
 class ParamError(GraphError):
@@ -35,9 +37,18 @@ class NodeInputError(GraphError):
 
 
 class ProjectFileError(ValueError):
-    """A project file that cannot be opened; names the path and the reason."""
+    """A project file that cannot be opened; names the path, where in it and the reason.
 
-    def __init__(self, path, reason: str):
-        super().__init__(f"cannot open project {str(path)!r}: {reason}")
+    path : the file as given.
+    where : the location in the file -- a JSON path such as ``nodes[3].position[0]``,
+        ``line 4, column 7`` or ``byte 120`` -- or "" when the whole file is at fault
+        (missing, a directory, empty).
+    reason : what is wrong, with the value found and what was expected.
+    """
+
+    def __init__(self, path, reason: str, *, where: str = ""):
+        located = f"{where}: {reason}" if where else reason
+        super().__init__(f"cannot open project {str(path)!r}: {located}")
         self.path = str(path)
+        self.where = where
         self.reason = reason

@@ -121,3 +121,63 @@ def test_autosave_module_does_not_import_qt():
     code = "import sys, app.autosave; sys.exit('PySide6' in sys.modules)"
     root = Path(__file__).resolve().parents[2]
     assert subprocess.run([sys.executable, "-c", code], cwd=root).returncode == 0
+
+
+def test_hostile_sidecars_are_skipped_not_raised(tmp_path):
+    pid = dead_pid()
+    good = AutosaveManager(tmp_path, pid=pid)
+    good.save(doc_with_seed(4), None)
+    name = good.autosave_path.name
+    hostile = {
+        "inf_pid.meta.json": '{"autosave": "%s", "saved_at": 1, "pid": Infinity}' % name,
+        "big_pid.meta.json": '{"autosave": "%s", "saved_at": 1, "pid": %s}' % (name, "9" * 30),
+        "nan_time.meta.json": '{"autosave": "%s", "saved_at": NaN, "pid": 1}' % name,
+        "huge_time.meta.json": '{"autosave": "%s", "saved_at": 1e400, "pid": 1}' % name,
+        "deep.meta.json": "[" * 100_000 + "]" * 100_000,
+        "dotdot.meta.json": json.dumps({"autosave": "..", "saved_at": 1, "pid": pid}),
+        "sidecar.meta.json": json.dumps({"autosave": "x.meta.json", "saved_at": 1, "pid": pid}),
+        "nul.meta.json": json.dumps({"autosave": name, "saved_at": 1, "pid": pid, "original_path": "a\0b"}),
+        "number.meta.json": json.dumps({"autosave": name, "saved_at": 1, "pid": pid, "original_path": 5}),
+        "binary.meta.json": b"\xff\xfe\x00",
+    }
+    for fname, content in hostile.items():
+        target = tmp_path / fname
+        target.write_bytes(content if isinstance(content, bytes) else content.encode())
+    items = AutosaveManager(tmp_path).find_recoverable()
+    # a pid no process can have is a dead one; an unusable original path means "the original is gone"
+    assert sorted(i.meta_path.name for i in items) == sorted([good.meta_path.name, "big_pid.meta.json",
+                                                              "nul.meta.json"])
+    for item in items:
+        AutosaveManager.discard(item)                    # never raises
+
+
+def test_pid_alive_of_an_impossible_pid_is_false():
+    assert not pid_alive(2**80) and not pid_alive(-5)
+
+
+def test_discard_removes_temporaries_a_killed_autosave_left(tmp_path):
+    crashed = AutosaveManager(tmp_path, pid=dead_pid())
+    crashed.save(doc_with_seed(3), None)
+    left = tmp_path / f".{crashed.autosave_path.name}.0a1b2c3d.tmp"
+    left.write_bytes(b'{"format": "meso')
+    os.utime(left, (time.time() - 600, time.time() - 600))
+    (item,) = AutosaveManager(tmp_path).find_recoverable()
+    AutosaveManager.discard(item)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_new_autosave_folder_is_private(tmp_path):
+    m = AutosaveManager(tmp_path / "auto")
+    m.save(doc_with_seed(1), None)
+    assert (tmp_path / "auto").stat().st_mode & 0o077 == 0
+
+
+def test_a_document_opened_from_any_loadable_file_autosaves(tmp_path):
+    from engine.graph import load_project
+    p = tmp_path / "p.json"
+    p.write_text(json.dumps({"format": "mesoforge-project", "version": 2, "seed": 2**64,
+                             "meta": {"x": 1e308, "n": [[[]]]},
+                             "nodes": [{"id": "v", "type": "Vertex", "position": [1, -2]}]}))
+    m = AutosaveManager(tmp_path / "auto")
+    m.save(load_project(p), p)
+    assert document_to_dict(load_project(m.autosave_path)) == document_to_dict(load_project(p))
