@@ -10,10 +10,14 @@ vector, realised probabilities and properties.
 
 Output files
 ------------
-``*.csv``: one header line, then one row per sample, appended as results
-arrive (``engine.batch.rows``): an interrupted run leaves only complete rows
-(plus at most a partial last line, cut off on resume) and ``resume=True``
-runs only the samples not yet in the file. Columns, in order
+``*.csv``: a tag line naming the study's parameters (``# mesoforge-study v1
+{...}``; ``engine.batch.study_file``), one header line, then one row per
+sample, appended as results arrive (``engine.batch.rows``): an interrupted
+run leaves only complete rows (plus at most a partial last line, cut off on
+resume) and ``resume=True`` runs only the samples not yet in the file. A
+file that is not a study file, or (when resuming) holds another study, is
+refused with ``StudyFileError`` before anything is written or grown, and is
+left exactly as it was. Columns, in order
 (``engine.batch.sample.columns``): ``set, index, seed, tileset, shape
 ("nx x ny[x nz]"), periodic, availability, hints`` (text ``name=w,...``),
 ``hint_<block>`` (normalised block hints), ``status`` (ok / singular /
@@ -26,8 +30,8 @@ block units (3D), ``void``), ``iterations, seconds`` and ``config`` (a hash
 of everything besides the seed that decides the row).
 
 ``*.parquet`` (needs pyarrow): rows are journaled to ``<name>.parquet.rows.csv``
-exactly as above and the Parquet file is rewritten from the journal at the
-end of every run.
+exactly as above and the Parquet file (tagged in its schema metadata) is
+rewritten from the journal at the end of every run.
 
 Seeds: sample ``i`` of a study uses ``sample_seed(seed, i)``, sample ``i`` of
 hint set ``j`` of a sweep ``sample_seed(seed, j, i)`` (``SeedSequence``
@@ -46,10 +50,11 @@ import numpy as np
 from engine.growth import TileSet, dirichlet_hints, hint_table, load_tileset
 from engine.growth.properties import check_options
 
-from .rows import RowFile, read_rows
+from .rows import StudyFileError, read_rows
 from .runner import run_samples
 from .sample import (STATUS_ERROR, STATUS_OK, STATUS_SINGULAR, Sample, StudyConfig, block_hints,
                      columns, evaluate_sample, sample_seed)
+from .study_file import check_parquet, parquet_metadata, plan_journal, read_params, study_params
 
 __all__ = ["run_study", "sweep_hints", "read_study", "summarise_rows", "make_config"]
 
@@ -137,7 +142,7 @@ def _out_files(out_path):
     raise ValueError(f"out_path must end in .csv or .parquet; got {str(p)!r}")
 
 
-def _write_parquet(rows: list, cols: list, path: Path) -> None:
+def _write_parquet(rows: list, cols: list, path: Path, params: dict) -> None:
     import io
 
     import pyarrow as pa
@@ -145,6 +150,7 @@ def _write_parquet(rows: list, cols: list, path: Path) -> None:
 
     from engine.fileio import write_atomic
     table = pa.table({c: [r.get(c) for r in rows] for c in cols})
+    table = table.replace_schema_metadata(parquet_metadata(params))
     buf = io.BytesIO()
     pq.write_table(table, buf)
     write_atomic(path, buf.getvalue())
@@ -191,27 +197,37 @@ def read_study(path) -> list:
 
 # ------------------------------------------------------------------ driver
 
-def _execute(config: StudyConfig, samples: list, *, out_path, scheduler, n_workers, progress,
-             resume) -> dict:
-    """Run the samples not yet in ``out_path``; return the rows of all ``samples``."""
+def _open_out(journal, parquet, cols, params, wanted, resume):
+    """Check the output files (reading only), then open the journal: the run's first write."""
+    try:
+        plan = plan_journal(journal, cols, params, wanted, resume=resume)
+        if parquet is not None:
+            check_parquet(parquet, cols, params, resume=resume,
+                          journal_exists=plan.scan is not None)
+        return plan.open()
+    except StudyFileError as exc:
+        raise exc.named("out_path") from None
+
+
+def _execute(config: StudyConfig, samples: list, *, params: dict, out_path, scheduler,
+             n_workers, progress, resume) -> dict:
+    """Run the samples not yet in ``out_path``; return the rows of all ``samples``.
+
+    ``params`` (``engine.batch.study_file.study_params``) tag the file; every
+    check of the output happens before the first byte is written or the
+    first sample is grown.
+    """
     t0 = time.perf_counter()
     cols = columns(config)
     journal, parquet = _out_files(out_path)
-    wanted = {s.seed: config.key(s.hints) for s in samples}
+    wanted = {s.seed: (s.set, s.index, config.key(s.hints)) for s in samples}
     rows_by_seed: dict = {}
     writer = None
     if journal is not None:
-        writer = RowFile(journal, cols, resume=resume)
+        writer = _open_out(journal, parquet, cols, params, wanted, resume)
         for r in writer.existing:
-            seed = r["seed"]
-            if seed in wanted:
-                if r["config"] != wanted[seed]:
-                    writer.close()
-                    raise ValueError(
-                        f"{str(journal)!r} already holds sample seed {seed} from a different "
-                        f"study (config {r['config']}, this one {wanted[seed]}): use another "
-                        f"out_path or resume=False")
-                rows_by_seed.setdefault(seed, r)
+            if r["seed"] in wanted:
+                rows_by_seed.setdefault(r["seed"], r)
     n_resumed = len(rows_by_seed)
     todo = [s for s in samples if s.seed not in rows_by_seed]
 
@@ -224,11 +240,17 @@ def _execute(config: StudyConfig, samples: list, *, out_path, scheduler, n_worke
         completed = run_samples(evaluate_sample, config, todo, on_row=on_row, scheduler=scheduler,
                                 n_workers=n_workers, progress=progress, done=n_resumed,
                                 total=len(samples))
+    except BaseException:
+        if writer is not None:          # failed before its first row: leave nothing behind
+            writer.discard_if_unused()
+        raise
     finally:
         if writer is not None:
             writer.close()
     if parquet is not None:
-        _write_parquet(read_rows(journal, columns=cols), cols, parquet)
+        # the journal's tag: it may list more hint groups than this run
+        _write_parquet(read_rows(journal, columns=cols), cols, parquet,
+                       read_params(journal) or params)
     rows = sorted(rows_by_seed.values(), key=lambda r: (r["set"], r["index"]))
     return {"rows": rows, "cancelled": not completed, "n_resumed": n_resumed,
             "n_new": len(rows) - n_resumed, "seconds": time.perf_counter() - t0,
@@ -261,7 +283,9 @@ def run_study(tileset, *, hints=None, n_samples: int = 100, shape=(20, 20),
         cancels pending samples and returns with what was written.
     resume : bool
         Keep the complete rows already in ``out_path`` and run only the missing
-        samples (a partial last line is cut off). False starts the file afresh.
+        samples (a partial last line is cut off); the file must hold this
+        study (same parameters, any number of samples). False starts a study
+        file afresh. A file that is not a study file is never written.
     availability : float, optional, blocks per cell (0 / None = unlimited)
     resolution, line_width, radius, void, tol
         As in ``engine.growth.properties.homogenize_tiling``.
@@ -282,8 +306,9 @@ def run_study(tileset, *, hints=None, n_samples: int = 100, shape=(20, 20),
     seed = _check_int("seed", seed, 0)
     h = _check_hints(config.tileset, hints, config.shape)
     samples = [Sample(0, i, sample_seed(seed, i), h) for i in range(n_samples)]
-    run = _execute(config, samples, out_path=out_path, scheduler=scheduler, n_workers=n_workers,
-                   progress=progress, resume=resume)
+    params = study_params(config, mode="hints", seed=seed, hints=[h])
+    run = _execute(config, samples, params=params, out_path=out_path, scheduler=scheduler,
+                   n_workers=n_workers, progress=progress, resume=resume)
     ts = config.tileset
     out = {"tileset": ts.name, "n_samples": n_samples,
            "hints": dict(zip(ts.block_names, block_hints(ts, h, config.shape).tolist()))}
@@ -328,8 +353,9 @@ def sweep_hints(tileset, *, n_hint_sets: int, samples_per_set: int, min_distance
     hint_sets = [dict(zip(ts.block_names, map(float, v))) for v in vectors]
     samples = [Sample(j, i, sample_seed(seed, j, i), hint_sets[j])
                for j in range(n_sets) for i in range(per_set)]
-    run = _execute(config, samples, out_path=out_path, scheduler=scheduler, n_workers=n_workers,
-                   progress=progress, resume=resume)
+    params = study_params(config, mode="sweep", seed=seed, min_distance=min_distance)
+    run = _execute(config, samples, params=params, out_path=out_path, scheduler=scheduler,
+                   n_workers=n_workers, progress=progress, resume=resume)
     by_set: dict = {j: [] for j in range(n_sets)}
     for r in run["rows"]:
         by_set[r["set"]].append(r)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from .sample import Sample, sample_seed
 from .study import _check_hints, _check_int, _execute, make_config, summarise_rows
+from .study_file import study_params
 
 __all__ = ["study_hint_groups"]
 
@@ -61,8 +62,9 @@ def study_hint_groups(tileset, hint_groups, *, samples_per_group: int, seed: int
             raise ValueError(f"hint group {j}: {exc}") from None
     samples = [Sample(j, i, sample_seed(seed, j, i), hint_sets[j])
                for j in range(len(hint_sets)) for i in range(per_group)]
-    run = _execute(config, samples, out_path=out_path, scheduler=scheduler, n_workers=n_workers,
-                   progress=progress, resume=resume)
+    params = study_params(config, mode="groups", seed=seed, hints=hint_sets)
+    run = _execute(config, samples, params=params, out_path=out_path, scheduler=scheduler,
+                   n_workers=n_workers, progress=progress, resume=resume)
     by_set: dict = {j: [] for j in range(len(hint_sets))}
     for r in run["rows"]:
         by_set[r["set"]].append(r)

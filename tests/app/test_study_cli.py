@@ -1,6 +1,9 @@
-"""`mesoforge study` for the window: hint groups, sweeps, progress lines, SIGTERM, study_argv."""
+"""`mesoforge study` for the window: hint groups, sweeps, progress lines, SIGTERM, study_argv,
+and --out files that must not be written."""
 
 import json
+import os
+import re
 import signal
 import subprocess
 import sys
@@ -10,7 +13,8 @@ import pytest
 
 from app import cli
 from app.growth_cmd import parse_progress_line, study_argv, study_process
-from engine.batch import read_study, sample_seed, sweep_hints
+import engine.batch.study as study_mod
+from engine.batch import read_study, run_study, sample_seed, sweep_hints
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = ["--size", "5x5", "--resolution", "10", "--scheduler", "synchronous"]
@@ -69,24 +73,30 @@ def test_bad_study_modes_exit_2_naming_them(capsys, args, match):
     assert code == 2 and match in err and err.startswith("mesoforge study: ")
 
 
+def _stop_after_two_rows(command, signum):
+    """Run a study with --progress-lines, send `signum` once two rows are done;
+    (exit code, the rest of stderr)."""
+    proc = subprocess.Popen(command, cwd=ROOT, stderr=subprocess.PIPE, text=True)
+    try:
+        for line in proc.stderr:
+            p = parse_progress_line(line)
+            if p is not None and p[0] >= 2:
+                proc.send_signal(signum)
+                break
+        rest = proc.stderr.read()
+        return proc.wait(timeout=30), rest
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
 def test_sigterm_stops_with_whole_rows_and_a_rerun_resumes(tmp_path):
     out = tmp_path / "t.csv"
     argv = ["study", "TL+-", "--n", "60", "--size", "8x8", "--resolution", "10",
             "--scheduler", "synchronous", "--group", "T=1", "--out", str(out), "--progress-lines"]
     program, args = study_process(argv)
-    proc = subprocess.Popen([program, *args], cwd=ROOT, stderr=subprocess.PIPE, text=True)
-    try:
-        for line in proc.stderr:
-            p = parse_progress_line(line)
-            if p is not None and p[0] >= 2:
-                proc.send_signal(signal.SIGTERM)
-                break
-        rest = proc.stderr.read()
-        code = proc.wait(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+    code, rest = _stop_after_two_rows([program, *args], signal.SIGTERM)
     assert code == 130, rest
     assert "stopped; rows so far are in" in rest
     kept = read_study(out)
@@ -97,6 +107,69 @@ def test_sigterm_stops_with_whole_rows_and_a_rerun_resumes(tmp_path):
     assert json.loads(r.stdout)["n_resumed"] == len(kept)
     rows = read_study(out)
     assert [row["index"] for row in rows] == list(range(60))
+
+
+def test_sigint_leaves_whole_rows_and_a_rerun_resumes(tmp_path):
+    out = tmp_path / "i.csv"
+    args = ["-m", "app.cli", "study", "TL+-", "--n", "40", "--size", "6x6", "--resolution", "8",
+            "--scheduler", "synchronous", "--out", str(out)]
+    code, rest = _stop_after_two_rows([sys.executable, *args, "--progress-lines"], signal.SIGINT)  # Ctrl-C
+    assert code == 130 and "interrupted; rows so far are in" in rest, rest
+    kept = read_study(out)
+    assert 2 <= len(kept) < 40 and out.read_bytes().endswith(b"\n")
+    args[args.index("--n") + 1] = str(len(kept) + 1)     # a rerun resumes, one more sample
+    r = subprocess.run([sys.executable, *args, "--json"], cwd=ROOT, capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    assert (s["n_resumed"], s["n_new"]) == (len(kept), 1)
+
+
+def _state(p):
+    st = os.stat(p)
+    return p.read_bytes(), st.st_mode, st.st_mtime_ns
+
+
+def _bad_out_cases(tmp_path):
+    notes = tmp_path / "notes.csv"
+    notes.write_bytes(b"a,b\n1,2\n3,4")
+    other = tmp_path / "other.csv"
+    run_study("TL+-", n_samples=1, seed=9, shape=(5, 5), resolution=10, out_path=other,
+              scheduler="synchronous")
+    (tmp_path / "dir.csv").mkdir()
+    # the reason as the engine words it; the CLI may refuse a folder or a missing folder
+    # itself, before the engine sees the path, so those two are matched loosely
+    return [(notes, r"is not a study file written by Mesoforge \(its first line is 'a,b'\)"),
+            (other, "holds another study: seed is 9 in the file, 0 in this run"),
+            (tmp_path / "dir.csv", "is a (folder|directory)"),
+            (tmp_path / "no" / "s.csv", f"{re.escape(repr(str(tmp_path / 'no')))} does not exist"),
+            (Path("/proc/mesoforge-x.csv"), "cannot create files in the folder '/proc'")]
+
+
+def test_unusable_out_files_exit_2_before_any_sample_and_stay_untouched(tmp_path, capsys,
+                                                                        monkeypatch):
+    cases = _bad_out_cases(tmp_path)
+    before = {p: _state(p) for p, _ in cases if p.is_file()}
+    listing = sorted(os.listdir(tmp_path))
+
+    def grown(*a, **k):
+        raise AssertionError("a sample was grown before --out was checked")
+    monkeypatch.setattr(study_mod, "run_samples", grown)
+    for path, reason in cases:
+        code, _out, err = _run(capsys, "study", "TL+-", "--n", 2, *SMALL, "--out", path)
+        assert code == 2, err
+        assert err.count("\n") == 1 and err.startswith("mesoforge study: ")
+        assert re.search(f"{re.escape(str(path))}'?: .*{reason}", err), err
+    assert {p: _state(p) for p in before} == before
+    assert sorted(os.listdir(tmp_path)) == listing and os.listdir(tmp_path / "dir.csv") == []
+
+
+def test_unusable_out_files_are_reported_as_out(tmp_path, capsys):
+    notes = tmp_path / "notes.csv"
+    notes.write_bytes(b"a,b\n1,2\n")
+    code, _out, err = _run(capsys, "study", "TL+-", "--n", 1, *SMALL, "--out", notes)
+    assert code == 2 and re.match(f"mesoforge study: --out '?{re.escape(str(notes))}'?: is not a "
+                                  f"study file", err), err
 
 
 def test_study_argv_is_what_the_parser_reads(tmp_path):

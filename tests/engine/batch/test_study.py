@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from engine.batch import read_study, run_study, sample_seed, sweep_hints
+from engine.batch import StudyFileError, read_study, run_study, sample_seed, sweep_hints
 from engine.batch.rows import read_rows
 from engine.growth import dirichlet_hints
 
@@ -94,7 +94,7 @@ def test_killed_process_resumes_to_the_same_rows(tmp_path):
     try:
         deadline = time.time() + 120
         while time.time() < deadline:
-            if out.exists() and out.read_bytes().count(b"\n") >= 3:   # header + 2 rows
+            if out.exists() and out.read_bytes().count(b"\n") >= 4:   # tag, header + 2 rows
                 break
             time.sleep(0.02)
         os.kill(proc.pid, signal.SIGKILL)
@@ -130,12 +130,15 @@ def test_cancel_on_a_cluster_keeps_whole_rows_and_resumes(tmp_path, dask_client)
 def test_resume_refuses_rows_of_a_different_study(tmp_path):
     out = tmp_path / "s.csv"
     run_study("TL+-", n_samples=2, seed=1, out_path=out, scheduler="synchronous", **SMALL)
-    with pytest.raises(ValueError, match="different study"):
+    before = out.read_bytes()
+    with pytest.raises(StudyFileError, match="hints is 'T=1.0,L=1.0,-=1.0,[+]=1.0' in the file, "
+                                             "'T=2.0,L=1.0,[+]=1.0,-=1.0' in this run"):
         run_study("TL+-", hints={"T": 2, "L": 1, "+": 1, "-": 1}, n_samples=2, seed=1,
                   out_path=out, scheduler="synchronous", **SMALL)
-    with pytest.raises(ValueError, match="different kind of study"):
+    with pytest.raises(StudyFileError, match="tileset is 'TL[+]-' in the file"):
         run_study("TL+-OV\\", n_samples=2, seed=1, out_path=out, scheduler="synchronous",
                   **SMALL)
+    assert out.read_bytes() == before
 
 
 @pytest.mark.parametrize("kwargs, match", [
