@@ -10,6 +10,13 @@
     mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--printability] [--node ID]
     mesoforge rd --preset cantilever|lbeam|bridge|mbb3d [--res WxH[xD]] [--grow-res WxH[xD]] --out OUT.png|OUT.stl
                  [--fields FILE.npz|.vti] [--seed N] [--json]
+
+Exit codes: 0 done; 1 a node failed on valid input; 2 bad input, refused
+before any work starts or any file is written, with one line on stderr
+``mesoforge <cmd>: --flag VALUE: reason (allowed: range)`` (ranges from the
+node schemas, sizes from the node types' memory estimates against the budget
+of engine.memory: the available memory, or MESOFORGE_MEMORY_LIMIT such as
+``2G``); 130 Ctrl-C, one line, no traceback.
 """
 
 from __future__ import annotations
@@ -28,8 +35,15 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def _fail(msg: str, code: int = 2) -> int:
-    print(f"mesoforge: {msg}", file=sys.stderr)
+COMMANDS = ("eval", "render", "homogenize", "grow", "study", "phasor", "rd")
+
+
+class _Refused(ValueError):
+    """Bad input that is not one flag's value (an unreadable project): exit 2."""
+
+
+def _fail(msg: str, code: int = 2, cmd: str | None = None) -> int:
+    print(f"mesoforge{' ' + cmd if cmd else ''}: {msg}", file=sys.stderr)
     return code
 
 
@@ -53,38 +67,86 @@ def _progress_printer(enabled: bool):
     return cb
 
 
-def cmd_eval(args) -> int:
-    from app.evaluation import evaluate_document, override_resolution, report_json, result_node, solid_of, tiled_mesh
-    from engine.geometry.mesh_io import export_mesh
+def _tiles(tiles, flag: str = "--tile") -> tuple:
+    from app.evaluation import MAX_TILES, check_tiles
+    from app.flags import FlagError
 
-    doc, err = _load(args.graph)
+    try:
+        return check_tiles(tiles)
+    except ValueError:
+        raise FlagError(flag, list(tiles), "out of range", f"integers in [1, {MAX_TILES}]") from None
+
+
+def _checked_graph(graph: str, tiles, *, resolution=None, node=None, tile_flag="--tile", tile_value=None):
+    """Load ``graph`` and refuse, before evaluating it, a --resolution, --node or
+    --tile that the graph cannot take or whose memory estimate exceeds the budget."""
+    from app.evaluation import GraphMemoryError, check_graph_memory, graph_tiling_estimate, override_resolution
+    from app.flags import FlagError, memory_value, schema_value
+
+    if resolution is not None:
+        resolution = schema_value("--resolution", resolution, "Object", "resolution")
+    doc, err = _load(graph)
     if doc is None:
-        return _fail(err)
-    if args.resolution is not None:
-        try:
-            override_resolution(doc, args.resolution)
-        except ValueError as exc:
-            return _fail(f"--resolution: {exc}")
+        raise _Refused(err)
+    if node is not None and node not in doc.nodes:
+        raise FlagError("--node", node, "no such node", ", ".join(doc.nodes) or "none: the graph is empty")
+    if resolution is not None:
+        override_resolution(doc, resolution)
+    try:
+        check_graph_memory(doc)
+    except GraphMemoryError as exc:
+        if resolution is not None and exc.type_name == "Object":
+            from app.flags import memory_error
+            raise memory_error("--resolution", resolution, exc, lower="--resolution") from None
+        raise _Refused(f"{graph}: {exc}") from None
+    memory_value(tile_flag, list(tiles) if tile_value is None else tile_value, graph_tiling_estimate(doc, tiles),
+                 lower=f"{tile_flag} or the Object resolution" if tile_value is None else "the Object resolution")
+    return doc
+
+
+def _tiled(solid, tiles, flag: str = "--tile"):
+    from app.evaluation import tiled_mesh
+    from app.flags import memory_error
+    from engine.memory import MemoryLimitError
+
+    try:
+        return tiled_mesh(solid, tiles)
+    except MemoryLimitError as exc:
+        raise memory_error(flag, list(tiles), exc, lower=f"{flag} or the Object resolution") from None
+
+
+def cmd_eval(args) -> int:
+    from app.evaluation import evaluate_document, report_json, result_node, solid_of
+    from app.flags import FlagError, output_path
+    from engine.geometry.mesh_io import SUPPORTED_SUFFIXES, export_mesh
+
+    try:
+        output_path("--out", args.out, SUPPORTED_SUFFIXES)
+        tiles = _tiles(args.tile)
+        doc = _checked_graph(args.graph, tiles, resolution=args.resolution, node=args.node)
+    except (FlagError, _Refused) as exc:
+        return _fail(str(exc), cmd="eval")
     report = evaluate_document(doc, on_progress=_progress_printer(not args.json and sys.stderr.isatty()))
     out = report_json(doc, report)
     code = 0 if report.ok else 1
-    try:
-        nid = result_node(doc, report, args.node)
-    except ValueError as exc:
-        return _fail(str(exc))
+    nid = result_node(doc, report, args.node)
     solid = solid_of(report, nid) if nid else None
     if solid is not None:
-        mesh = tiled_mesh(solid, args.tile)
+        try:
+            mesh = _tiled(solid, tiles)
+        except FlagError as exc:
+            return _fail(str(exc), cmd="eval")
         out["result_node"] = nid
         out["mesh"] = mesh.summary
-        if args.out:
+        if args.out is not None:
             try:
                 export_mesh(mesh.vertices, mesh.faces, args.out)
             except (ValueError, OSError) as exc:
-                return _fail(f"--out {args.out}: {exc}")
+                return _fail(f"--out {args.out}: cannot write: {exc}", 1, cmd="eval")
             out["mesh"]["path"] = str(Path(args.out).resolve())
-    elif args.out:
-        out.setdefault("warnings", []).append("no solid result to export")
+    elif args.out is not None:
+        out.setdefault("warnings", []).append(f"no solid result to export; {args.out} was not written")
+        print(f"mesoforge eval: --out {args.out}: no solid result to export; nothing written", file=sys.stderr)
         code = 1
     if args.json:
         print(json.dumps(out, indent=1, default=float))
@@ -100,23 +162,39 @@ def cmd_eval(args) -> int:
     return code
 
 
-def render_headless(graph: str, png: str, mesh_out: str | None = None, tiles=(1, 1, 1)) -> dict:
+def check_render_args(graph: str, png: str, mesh_out: str | None = None, tiles=(1, 1, 1), *,
+                      tile_flag: str = "--tile"):
+    """The loaded graph once every render argument is checked (FlagError or
+    _Refused otherwise); nothing is evaluated or written."""
+    from app.flags import distinct_outputs, output_path
+    from engine.geometry.mesh_io import SUPPORTED_SUFFIXES
+
+    output_path("--png", png, (".png",))
+    output_path("--out", mesh_out, SUPPORTED_SUFFIXES)
+    distinct_outputs(("--png", png), ("--out", mesh_out))
+    tiles = _tiles(tiles, tile_flag)
+    return _checked_graph(graph, tiles, tile_flag=tile_flag), tiles
+
+
+def render_headless(graph: str, png: str, mesh_out: str | None = None, tiles=(1, 1, 1), *,
+                    doc=None) -> dict:
     """Evaluate a project and render its result to a PNG without a display."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    from app.evaluation import evaluate_document, result_node, solid_of, tiled_mesh
+    from app.evaluation import evaluate_document, result_node, solid_of
     from app.render import render_mesh_png
     from engine.geometry.mesh_io import export_mesh
 
-    doc, err = _load(graph)
     if doc is None:
-        raise ValueError(err)
+        doc, tiles = check_render_args(graph, png, mesh_out, tiles)
     report = evaluate_document(doc)
     nid = result_node(doc, report)
     solid = solid_of(report, nid) if nid else None
     if solid is None:
         raise ValueError(f"{graph}: evaluation produced no solid ({report.errors or 'no Object node'})")
-    mesh = tiled_mesh(solid, tiles)
+    mesh = _tiled(solid, tiles)
     render_mesh_png(mesh.vertices, mesh.faces, png)
+    if not Path(png).is_file():       # never report a picture that was not written
+        raise OSError(f"--png {png}: the renderer wrote no file")
     if mesh_out:
         export_mesh(mesh.vertices, mesh.faces, mesh_out)
     return {"png": str(Path(png).resolve()), "mesh": str(Path(mesh_out).resolve()) if mesh_out else None,
@@ -124,26 +202,44 @@ def render_headless(graph: str, png: str, mesh_out: str | None = None, tiles=(1,
 
 
 def cmd_render(args) -> int:
+    from app.flags import FlagError
+
     try:
-        info = render_headless(args.graph, args.png, args.out, args.tile)
+        doc, tiles = check_render_args(args.graph, args.png, args.out, args.tile)
+    except (FlagError, _Refused) as exc:
+        return _fail(str(exc), cmd="render")
+    try:
+        info = render_headless(args.graph, args.png, args.out, tiles, doc=doc)
+    except FlagError as exc:
+        return _fail(str(exc), cmd="render")
     except (ValueError, OSError) as exc:
-        return _fail(str(exc))
+        return _fail(str(exc), 1, cmd="render")
     print(json.dumps(info, indent=1, default=float))
     return 0
 
 
 def cmd_open(project: str | None) -> int:
+    from app.flags import FlagError
+
     path = project or (str(DEFAULT_EXAMPLE) if DEFAULT_EXAMPLE.exists() else None)
     if not has_display():
         if path is None:
             return _fail("no display and no example project to render")
         out_dir = Path.cwd() / "mesoforge-out"
-        out_dir.mkdir(exist_ok=True)
         stem = Path(path).stem
+        png, stl = str(out_dir / f"{stem}.png"), str(out_dir / f"{stem}.stl")
         try:
-            info = render_headless(path, str(out_dir / f"{stem}.png"), str(out_dir / f"{stem}.stl"), (3, 3, 3))
-        except (ValueError, OSError) as exc:
+            tiles = (3, 3, 3)        # the headless picture shows a 3x3x3 block
+            doc = _checked_graph(path, tiles, tile_flag="PROJECT", tile_value=f"{path} (3x3x3 cells)")
+        except (FlagError, _Refused) as exc:
             return _fail(str(exc))
+        try:
+            out_dir.mkdir(exist_ok=True)
+            info = render_headless(path, png, stl, tiles, doc=doc)
+        except FlagError as exc:
+            return _fail(str(exc))
+        except (ValueError, OSError) as exc:
+            return _fail(str(exc), 1)
         print("No display found: rendered the project headlessly.")
         print(f"  picture: {info['png']}")
         print(f"  mesh:    {info['mesh']}  ({info['face_count']} faces, watertight={info['watertight']})")
@@ -153,8 +249,10 @@ def cmd_open(project: str | None) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="mesoforge", description="Design architected materials.")
-    sub = p.add_subparsers(dest="command")
+    from app.flags import OneLineParser
+
+    p = OneLineParser(prog="mesoforge", description="Design architected materials.")
+    sub = p.add_subparsers(dest="command", parser_class=OneLineParser)
     e = sub.add_parser("eval", help="evaluate a graph headlessly and summarise it")
     e.add_argument("graph")
     e.add_argument("--out", help="write the result mesh (.stl .obj .ply .3mf)")
@@ -178,14 +276,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
+def _dispatch(argv: list[str]) -> int:
     if not argv or (len(argv) == 1 and argv[0].endswith(".json") and not argv[0].startswith("-")):
         return cmd_open(argv[0] if argv else None)
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:          # argparse: --help (0) or a one-line refusal (2)
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     if args.command == "eval":
-        if any(t < 1 or t > 20 for t in args.tile):
-            return _fail(f"--tile {args.tile}: each count must be between 1 and 20")
         return cmd_eval(args)
     if args.command == "render":
         return cmd_render(args)
@@ -203,6 +301,24 @@ def main(argv: list[str] | None = None) -> int:
         return rd_cmd.run(args)
     build_parser().print_help()
     return 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command; bad input exits 2 with one line, Ctrl-C 130 with one
+    line, never a traceback for either."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    cmd = argv[0] if argv and argv[0] in COMMANDS else None
+    from engine.memory import memory_budget
+    try:
+        memory_budget()
+    except ValueError as exc:          # a malformed MESOFORGE_MEMORY_LIMIT
+        return _fail(str(exc), 2, cmd)
+    try:
+        return _dispatch(argv)
+    except KeyboardInterrupt:
+        return _fail("interrupted", 130, cmd)
+    except MemoryError:                # an allocation the estimates did not foresee
+        return _fail("out of memory; lower the resolution, size or tiles", 1, cmd)
 
 
 if __name__ == "__main__":

@@ -7,8 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from engine.graph import EvalReport, Evaluator, GraphDocument, SetParam, UndoStack
+from engine.graph import EvalReport, Evaluator, GraphDocument, SetParam, UndoStack, node_type
+from engine.graph.errors import GraphError
 from engine.graph.values import Solid, VoxelModel
+from engine.memory import MemoryLimitError, check_budget, tiled_mesh_bytes
+
+# Cells per axis of a tiled mesh (eval / render --tile, the window's export).
+MAX_TILES = 20
 
 
 def result_node(doc: GraphDocument, report: EvalReport, node_id: str | None = None) -> str | None:
@@ -54,14 +59,33 @@ class MeshResult:
     summary: dict
 
 
+def check_tiles(tiles) -> tuple:
+    """Three whole cell counts in [1, MAX_TILES]; ValueError otherwise."""
+    t = tuple(tiles)
+    if len(t) != 3 or any(isinstance(v, bool) or int(v) != v or not 1 <= v <= MAX_TILES for v in t):
+        raise ValueError(f"tiles {list(t)}: expected three integers in [1, {MAX_TILES}]")
+    return tuple(int(v) for v in t)
+
+
+def tiled_mesh_estimate(solid: Solid, tiles) -> int:
+    """Peak bytes of `tiled_mesh` (``engine.memory.tiled_mesh_bytes`` of the
+    solid's grid and face count)."""
+    if not solid.periodic:
+        return 0
+    return tiled_mesh_bytes(np.shape(solid.sdf), tiles, len(solid.faces))
+
+
 def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
     """The solid's mesh tiled ``tiles`` cells per axis (copies at multiples of
     the box, ``solid.box`` mm), with its summary; one marching-cubes pass over
-    the tiled field, so the block is watertight."""
+    the tiled field, so the block is watertight.  Raises MemoryLimitError
+    (before allocating) when the tiled mesh would not fit the budget."""
     from engine.geometry.marching import periodic_mesh
     from engine.geometry.mesh_io import mesh_summary
 
-    tiles = tuple(int(t) for t in tiles)
+    tiles = check_tiles(tiles)
+    check_budget(tiled_mesh_estimate(solid, tiles), what=f"tiling {'x'.join(map(str, tiles))} cells",
+                 lower="the tiles or the resolution", where="tiles")
     if tiles == (1, 1, 1):
         v, f = np.asarray(solid.vertices), np.asarray(solid.faces)
     else:
@@ -124,6 +148,55 @@ def report_json(doc: GraphDocument, report: EvalReport) -> dict:
     if warnings:
         out["warnings"] = warnings
     return out
+
+
+class GraphMemoryError(MemoryLimitError):
+    """A node of the graph whose memory estimate exceeds the budget; ``node``
+    is its id, ``type_name`` its type."""
+
+    def __init__(self, exc: MemoryLimitError, node: str, type_name: str):
+        super().__init__(f"node {node!r} ({type_name}): {exc}", need=exc.need, budget=exc.budget,
+                         lower=exc.lower, where=exc.where)
+        self.node, self.type_name = node, type_name
+
+
+def check_graph_memory(doc: GraphDocument) -> None:
+    """Refuse a graph any node of which would exceed the memory budget, from
+    the parameters alone (``NodeType.check_memory`` without inputs), before
+    anything is evaluated.  Nodes with bad parameters are left to the
+    evaluator, which reports them."""
+    for nid in doc.topological_order():
+        node = doc.nodes[nid]
+        try:
+            cls = node_type(node.type_name)
+            params = cls.validate_params(node.params, nid)
+        except (KeyError, GraphError):
+            continue
+        try:
+            cls.check_memory(params, None)
+        except MemoryLimitError as exc:
+            raise GraphMemoryError(exc, nid, node.type_name) from None
+
+
+def solid_grid_shape(doc: GraphDocument) -> tuple | None:
+    """The largest Object grid of the graph (nodes per axis), or None: what a
+    tiled mesh of its result is made from."""
+    shapes = []
+    for nid, node in doc.nodes.items():
+        if node.type_name == "Object":
+            cls = node_type("Object")
+            try:
+                shapes.append(cls.grid_shape(cls.validate_params(node.params, nid)))
+            except GraphError:
+                continue
+    return max(shapes, key=lambda s: int(np.prod(s)), default=None)
+
+
+def graph_tiling_estimate(doc: GraphDocument, tiles) -> int:
+    """Peak bytes of tiling the graph's solid ``tiles`` times, before it is
+    evaluated (face count bounded from the grid)."""
+    shape = solid_grid_shape(doc)
+    return 0 if shape is None else tiled_mesh_bytes(shape, tiles)
 
 
 def evaluate_document(doc: GraphDocument, *, on_progress=None) -> EvalReport:

@@ -101,8 +101,14 @@ def _tileset(text: str):
 
 
 def parse_size(text: str, ndim: int) -> tuple:
-    """``"20x20"`` / ``"20x20x10"`` (nx x ny [x nz]) -> grid shape ``(ny, nx)`` / ``(nz, ny, nx)``."""
-    parts = text.lower().replace("*", "x").split("x")
+    """``"20x20"`` / ``"20x20x10"`` (nx x ny [x nz]) -> grid shape ``(ny, nx)`` / ``(nz, ny, nx)``.
+
+    The counts are checked by the Grow node's ``size`` schema and its cell
+    limit (the node that runs the growth in a graph)."""
+    from engine.graph import ParamError, node_type
+    from engine.nodes.growth import MAX_CELLS
+
+    parts = str(text).lower().replace("*", "x").split("x")
     try:
         n = [int(p) for p in parts]
     except ValueError:
@@ -110,11 +116,30 @@ def parse_size(text: str, ndim: int) -> tuple:
     if len(n) != ndim:
         want = "NXxNY" if ndim == 2 else "NXxNYxNZ"
         raise _BadInput(f"--size {text!r}: the tile set is {ndim}D, expected {want}")
-    if any(v < 1 for v in n):
-        raise _BadInput(f"--size {text!r}: every count must be >= 1")
-    if math.prod(n) > 4_000_000:
-        raise _BadInput(f"--size {text!r}: {math.prod(n)} cells is more than 4000000")
+    param = node_type("Grow").param("size")
+    try:
+        param.coerce(n)
+    except ParamError:
+        raise _BadInput(f"--size {text!r}: every count must be in [{param.minimum:g}, {param.maximum:g}] "
+                        f"(allowed: {param.allowed()})") from None
+    if math.prod(n) > MAX_CELLS:
+        raise _BadInput(f"--size {text!r}: {math.prod(n)} cells is more than {MAX_CELLS} "
+                        f"(allowed: at most {MAX_CELLS} cells)")
     return tuple(n[::-1])
+
+
+def _grow_memory(text: str, shape, ts, *, samples: int = 1, resolution=None) -> None:
+    """Refuse a --size whose growth (and, for a study, the homogenization of
+    each sample, ``samples`` at once) would exceed the memory budget."""
+    from app.flags import memory_value
+    from engine.graph import node_type
+
+    need = node_type("Grow").memory_estimate({"size": list(shape[::-1])}, {"tileset": ts})
+    if resolution is not None:      # each sample is homogenized as the Tiling Properties node does
+        from engine.nodes.growth import tiling_properties_bytes
+        need += tiling_properties_bytes(shape, resolution)
+    lower = "--size" + (" or --resolution" if resolution is not None else "") + (" or --workers" if samples > 1 else "")
+    memory_value("--size", text, need * samples, lower=lower)
 
 
 def _hints(text: str, ts):
@@ -126,9 +151,10 @@ def _hints(text: str, ts):
 
 
 def _availability(value: float):
-    if math.isnan(value) or value < 0:
-        raise _BadInput(f"--availability {value}: expected a number >= 0 (0 = unlimited)")
-    return None if value == 0 or math.isinf(value) else float(value)
+    from app.flags import schema_value
+
+    value = schema_value("--availability", value, "Grow", "availability")   # 0 = unlimited
+    return None if value == 0 else float(value)
 
 
 def _write_png(path: str, image) -> None:
@@ -143,14 +169,21 @@ def _write_png(path: str, image) -> None:
 def _grow(args) -> int:
     from engine.growth import grow_tiling, realised_probabilities, save_tiling, tiling_image
 
+    from app.flags import distinct_outputs, output_path
+
+    output_path("--out", args.out, (".json",))
+    output_path("--png", args.png, (".png",))
+    distinct_outputs(("--out", args.out), ("--png", args.png))
     ts = _tileset(args.tileset)
     shape = parse_size(args.size, ts.ndim)
     hints = _hints(args.hints, ts)
     availability = _availability(args.availability)
     if args.seed < 0:
-        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0")
+        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0 (allowed: 0, 1, 2, ...)")
     if args.png and ts.ndim != 2:
-        raise _BadInput(f"--png: tile set {ts.name!r} is 3D; images are for 2D tilings")
+        raise _BadInput(f"--png {args.png}: tile set {ts.name!r} is 3D; images are for 2D tilings "
+                        f"(allowed: --png with a 2D tile set)")
+    _grow_memory(args.size, shape, ts)
     t0 = time.perf_counter()
     tiling = grow_tiling(ts, shape, hints=hints, periodic=args.periodic,
                          availability=availability, rng=args.seed)
@@ -259,10 +292,6 @@ def _run_mode(args, mode, ts, common) -> dict:
         return study_hint_groups(ts, _group_hints(args.group, ts), samples_per_group=args.n,
                                  **common)
     if mode == "--sweep":
-        if args.sweep < 1:
-            raise _BadInput(f"--sweep {args.sweep}: expected a number of hint vectors >= 1")
-        if not math.isfinite(args.min_distance) or args.min_distance < 0:
-            raise _BadInput(f"--min-distance {args.min_distance}: expected a number >= 0")
         return sweep_hints(ts, n_hint_sets=args.sweep, samples_per_set=args.n,
                            min_distance=args.min_distance, **common)
     return run_study(ts, hints=_hints(args.hints, ts), n_samples=args.n, **common)
@@ -284,16 +313,36 @@ def _print_study(ts, size, summary) -> None:
 
 
 def _study(args) -> int:
+    from app.flags import output_path, schema_value
+    from engine.batch.rows import StudyFileError
+
+    output_path("--out", args.out, (".csv", ".parquet"))
     ts = _tileset(args.tileset)
     size = args.size or ("20x20" if ts.ndim == 2 else "10x10x10")
     shape = parse_size(size, ts.ndim)
     mode = _study_mode(args)
     if args.n < 1:
-        raise _BadInput(f"--n {args.n}: expected a number of samples >= 1")
+        raise _BadInput(f"--n {args.n}: expected a number of samples >= 1 (allowed: 1, 2, ...)")
     if args.seed < 0:
-        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0")
+        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0 (allowed: 0, 1, 2, ...)")
     if args.workers < 1:
-        raise _BadInput(f"--workers {args.workers}: expected an integer >= 1")
+        raise _BadInput(f"--workers {args.workers}: expected an integer >= 1 (allowed: 1, 2, ...)")
+    if mode == "--sweep" and args.sweep < 1:
+        raise _BadInput(f"--sweep {args.sweep}: expected a number of hint vectors >= 1 (allowed: 1, 2, ...)")
+    if not math.isfinite(args.min_distance) or args.min_distance < 0:
+        raise _BadInput(f"--min-distance {args.min_distance}: expected a number >= 0 (allowed: [0, inf))")
+    # the solid's material and pixels per block: the TilingProperties node's ranges
+    schema_value("--E", args.E, "TilingProperties", "E")
+    schema_value("--nu", args.nu, "TilingProperties", "nu")
+    if args.resolution is not None:
+        schema_value("--resolution", args.resolution, "TilingProperties", "resolution")
+    if args.hints:
+        _hints(args.hints, ts)
+    if args.group:
+        _group_hints(args.group, ts)
+    workers = 1 if args.scheduler else args.workers
+    _grow_memory(size, shape, ts, samples=max(1, min(workers, args.n)),
+                 resolution=args.resolution or 0)
     stop = _StopOnTerm()
     interactive = args.progress_lines or sys.stderr.isatty()
     common = dict(shape=shape, periodic=not args.bounded, seed=args.seed, E=args.E, nu=args.nu,
@@ -306,6 +355,8 @@ def _study(args) -> int:
             summary = _run_mode(args, mode, ts, common)
     except _BadInput:
         raise
+    except StudyFileError as exc:         # the engine names its argument; the user gave --out
+        raise _BadInput(f"--out {exc.path}: {exc.reason}") from None
     except ValueError as exc:
         raise _BadInput(str(exc)) from None
     except KeyboardInterrupt:
@@ -392,7 +443,9 @@ def study_process(argv) -> tuple:
 
 
 def run(args) -> int:
+    from app.flags import FlagError
+
     try:
         return _grow(args) if args.command == "grow" else _study(args)
-    except _BadInput as exc:
+    except (_BadInput, FlagError) as exc:
         return _fail(args.command, str(exc))

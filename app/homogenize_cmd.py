@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -14,35 +15,67 @@ def add_parser(sub) -> None:
     h.add_argument("input", help=".npy / .vti voxel grid, .png pixel image (2D), or a closed mesh (.stl .obj .ply .3mf)")
     h.add_argument("--E", type=float, default=1.0, help="Young's modulus of the base material (default 1)")
     h.add_argument("--nu", type=float, default=0.45, help="Poisson's ratio of the base material (default 0.45)")
-    h.add_argument("--res", type=int, help="voxels per edge when voxelizing a mesh (default 64)")
+    h.add_argument("--res", type=int, help="voxels per edge when voxelizing a mesh (default 100)")
     h.add_argument("--json", action="store_true", help="print a JSON summary")
 
 
+def check_args(args) -> tuple:
+    """``(shape, kind)`` of the input from its header once every argument is
+    checked; raises FlagError before anything is read in full."""
+    from app.flags import FlagError, memory_error, schema_value
+    from engine.geometry.voxel_inputs import INPUT_SUFFIXES, MAX_RES, SOLVER_BYTES_PER_DOF, check_memory, grid_shape_of
+    from engine.memory import MemoryLimitError
+
+    # the base material's ranges are the Voxel node's, which carries them in a graph
+    args.E = schema_value("--E", args.E, "Voxel", "E")
+    args.nu = schema_value("--nu", args.nu, "Voxel", "nu")
+    if args.res is not None and not 2 <= args.res <= MAX_RES:
+        raise FlagError("--res", args.res, "out of range", f"an integer in [2, {MAX_RES}]")
+    suffix = Path(args.input).suffix.lower()
+    if suffix not in INPUT_SUFFIXES:
+        raise FlagError("INPUT", args.input, f"unsupported extension {suffix!r}" if suffix else "no extension",
+                        "a file ending in " + ", ".join(INPUT_SUFFIXES))
+    if not Path(args.input).is_file():
+        raise FlagError("INPUT", args.input, "no such file", "an existing file")
+    shape = grid_shape_of(args.input, res=args.res)
+    if shape is not None:
+        try:
+            check_memory(shape, per_dof_bytes=SOLVER_BYTES_PER_DOF)
+        except MemoryLimitError as exc:
+            if args.res is not None:
+                raise memory_error("--res", args.res, exc, lower="--res") from None
+            raise FlagError("INPUT", args.input, str(exc)) from None
+    return shape
+
+
 def run(args) -> int:
-    from engine.geometry.voxel_inputs import check_memory, load_voxel_grid, validate_density
+    from app.flags import FlagError
+    from engine.geometry.voxel_inputs import load_voxel_grid, validate_density
     from engine.physics.elastic import engineering_constants, symmetry_class, zener_ratio
     from engine.physics.homogenize2d import homogenize_pixels
     from engine.physics.homogenize3d import homogenize_voxels
 
-    def fail(msg: str) -> int:
+    def fail(msg: str, code: int = 2) -> int:
         print(f"mesoforge homogenize: {msg}", file=sys.stderr)
-        return 2
+        return code
 
-    if args.res is not None and not 2 <= args.res <= 512:
-        return fail(f"--res {args.res}: expected an integer in [2, 512]")
+    try:
+        check_args(args)
+    except FlagError as exc:
+        return fail(str(exc))
     try:
         grid, kind, info = load_voxel_grid(args.input, res=args.res)
         validate_density(grid, cubic=(kind == "voxels"))
-        if kind == "voxels":
-            check_memory(grid.shape)
-    except (ValueError, OSError, MemoryError) as exc:
-        return fail(f"{args.input}: {exc}")
+    except (ValueError, OSError) as exc:
+        return fail(f"INPUT {args.input}: {exc}")
     t0 = time.perf_counter()
     try:
         solve = homogenize_voxels if kind == "voxels" else homogenize_pixels
         result = solve(np.asarray(grid, dtype=np.float64), E=args.E, nu=args.nu)
+    except MemoryError as exc:     # the solver's own check, on the exact solid count
+        return fail(f"INPUT {args.input}: {exc}")
     except ValueError as exc:
-        return fail(str(exc))
+        return fail(str(exc), 1)
     C = np.asarray(result.C)
     try:
         sym = symmetry_class(C, tol=1e-3)

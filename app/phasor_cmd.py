@@ -145,10 +145,12 @@ def _settings(args):
     try:
         return PrintSettings.from_dict(data)
     except (TypeError, ValueError) as exc:
-        flag = {"layer_height": "--layer", "nozzle_diameter": "--nozzle", "perimeters": "--perimeters"}
+        flags = {"layer_height": ("--layer", args.layer), "nozzle_diameter": ("--nozzle", args.nozzle),
+                 "perimeters": ("--perimeters", args.perimeters)}
         text = str(exc)
-        named = next((f for k, f in flag.items() if text.startswith(k)), "--settings")
-        raise _BadInput(f"{named}: {text}") from None
+        named, value = next(((f, v) for k, (f, v) in flags.items() if text.startswith(k) and v is not None),
+                            ("--settings", args.settings))
+        raise _BadInput(f"{named} {value}: {text}") from None
 
 
 def _png_bytes(diamonds) -> bytes:
@@ -221,9 +223,6 @@ def _print_settings(args, infill):
         check_pixel(infill.fields, args.px)
     except ValueError as exc:
         raise _BadInput(f"--px {args.px}: {exc}") from None
-    if args.px > 0.5 * settings.nozzle_diameter:
-        raise _BadInput(f"--px {args.px}: the walls need a pixel below half the nozzle "
-                        f"({0.5 * settings.nozzle_diameter:g} mm)")
     return settings
 
 
@@ -284,14 +283,43 @@ def _printability_output(args, infill, out, settings) -> None:
 
 
 def _check_args(args) -> None:
-    if not (args.png or args.json or args.gcode or args.printability):
+    """Every argument checked before the project is read (FlagError / _BadInput)."""
+    from app.flags import distinct_outputs, output_path, schema_value
+
+    if not (args.png is not None or args.json or args.gcode is not None or args.printability):
         raise _BadInput("nothing to do: give --png, --json (with --slice), --gcode or --printability")
+    output_path("--png", args.png, (".png",))
+    output_path("--gcode", args.gcode, (".gcode",))
+    distinct_outputs(("--png", args.png), ("--gcode", args.gcode))
     if (args.png or (args.json and not (args.gcode or args.printability))) and not args.slice:
         raise _BadInput(f"{'--png' if args.png else '--json'} needs --slice AXIS=MM (e.g. z=2.5)")
     if args.slice:
         parse_slice(args.slice)
-    if not (math.isfinite(args.px) and args.px > 0):
-        raise _BadInput(f"--px {args.px}: expected a positive pixel size in mm")
+    # the pixel's range is the Phasor Slice node's, which slices the infill in a graph
+    args.px = schema_value("--px", args.px, "PhasorSlice", "pixel")
+    if args.gcode or args.printability:
+        settings = _settings(args)
+        if args.px > 0.5 * settings.nozzle_diameter:
+            raise _BadInput(f"--px {args.px}: the walls need a pixel below half the nozzle "
+                            f"(allowed: below {0.5 * settings.nozzle_diameter:g} mm)")
+
+
+def _check_memory(args, infill, settings) -> None:
+    """Refuse --px / --layer whose slices would exceed the memory budget
+    (the Phasor Slice node's estimate over the infill's box)."""
+    from app.flags import memory_value
+    from engine.graph import node_type
+    from engine.nodes.phasor import print_memory_estimate
+
+    if args.slice and (args.png or args.json):
+        axis, _ = parse_slice(args.slice)
+        need = node_type("PhasorSlice").memory_estimate({"axis": axis, "pixel": args.px}, {"infill": infill})
+        memory_value("--px", args.px, need, lower="raise --px (coarser pixels)")
+    if settings is not None:
+        f = infill.fields
+        need = print_memory_estimate(f.lo, f.hi, args.px, settings.layer_height)
+        flag, value = ("--layer", settings.layer_height) if args.layer is not None else ("--px", args.px)
+        memory_value(flag, value, need, lower="raise --px or --layer")
 
 
 def _print_text(out) -> None:
@@ -325,25 +353,29 @@ def printability_table(p: dict) -> str:
 
 
 def run(args) -> int:
+    from app.flags import FlagError
+
     out = {}
     try:
         _check_args(args)
         nid, infill = _infill(args)
         out.update(project=str(Path(args.project).resolve()), node=nid)
+        settings = _print_settings(args, infill) if (args.gcode or args.printability) else None
+        _check_memory(args, infill, settings)
         if args.slice and (args.png or args.json):
             _slice_outputs(args, infill, out)
-        settings = _print_settings(args, infill) if (args.gcode or args.printability) else None
         if args.gcode:
             _gcode_output(args, infill, out, settings)
         if args.printability:
             _printability_output(args, infill, out, settings)
-    except _BadInput as exc:
+    except (_BadInput, FlagError) as exc:
         return _fail(str(exc), 2)
     except _Failed as exc:
         return _fail(str(exc), 1)
     except KeyboardInterrupt:
         where = f"; {args.gcode} was not written" if args.gcode and "gcode" not in out else ""
-        print(file=sys.stderr)
+        if sys.stderr.isatty():      # end the \r progress line
+            print(file=sys.stderr)
         return _fail(f"interrupted{where}", 130)
     if args.json:
         print(json.dumps(out, indent=1))

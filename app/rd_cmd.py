@@ -23,6 +23,7 @@ valid arguments exits with 1.
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -62,36 +63,80 @@ def _fail(msg: str, code: int) -> int:
 
 
 def parse_size(text: str, flag: str) -> list:
-    """``"64x32"`` -> ``[64, 32]``; 2 or 3 positive integers."""
+    """``"64x32"`` -> ``[64, 32]``; 2 or 3 integers (their range is the node's)."""
     parts = (text or "").lower().split("x")
     try:
         size = [int(p) for p in parts]
     except ValueError:
         size = []
-    if len(size) not in (2, 3) or min(size) < 2:
-        raise _BadInput(f"{flag} {text!r}: expected WxH or WxHxD with integers >= 2, e.g. 64x32")
+    if len(size) not in (2, 3):
+        raise _BadInput(f"{flag} {text!r}: expected WxH or WxHxD with integers, e.g. 64x32")
     return size
 
 
+def _grid_text(size) -> str:
+    return "x".join(str(n) for n in size)
+
+
+def _check_grids(args, res, grow, dim) -> None:
+    """--res and --grow-res against the TopOpt / RDGrow schemas, their cell
+    limits and memory estimates; a growth grid derived from --res is refused
+    as --res."""
+    from app.flags import FlagError, memory_value, schema_value
+    from engine.graph import node_type
+    from engine.nodes.rd import MAX_FIELD_CELLS
+    from engine.nodes.rd_topopt import MAX_ELEMENTS
+
+    if res and not args.fields:
+        from engine.graph import NodeInputError
+        from engine.nodes.rd_topopt import preset_problem
+
+        schema_value("--res", res, "TopOpt", "resolution", as_typed=args.res or _grid_text(res))
+        try:   # the preset's own demands (an L-beam is square), as the TopOpt node checks them
+            preset_problem(args.preset, res)
+        except NodeInputError as exc:
+            raise FlagError("--res", _grid_text(res), str(exc)) from None
+        if math.prod(res) > MAX_ELEMENTS[dim]:
+            raise FlagError("--res", _grid_text(res), f"{math.prod(res)} elements",
+                            f"at most {MAX_ELEMENTS[dim]} in {dim}D")
+        need = node_type("TopOpt").memory_estimate({"preset": args.preset, "resolution": res})
+        memory_value("--res", _grid_text(res), need, lower="--res")
+    derived = not args.grow_res
+    flag, shown = ("--res", args.res) if derived else ("--grow-res", args.grow_res)
+    why = f"the growth grid {_grid_text(grow)} ({UPSAMPLE[dim]} x --res) " if derived else ""
+    p = node_type("RDGrow").param("resolution")
+    try:
+        p.coerce(grow)
+    except ValueError:
+        raise FlagError(flag, shown, f"{why}is out of range" if why else "out of range",
+                        p.allowed() + (" per axis; or give --grow-res" if derived else " per axis")) from None
+    if math.prod(grow) > MAX_FIELD_CELLS:
+        raise FlagError(flag, shown, f"{why}has {math.prod(grow)} cells",
+                        f"at most {MAX_FIELD_CELLS} cells" + ("; or give --grow-res" if derived else ""))
+    need = node_type("RDGrow").memory_estimate({"resolution": grow})
+    memory_value(flag, shown, need, lower="--grow-res" if not derived else "--res or give --grow-res")
+
+
 def _check_args(args) -> dict:
+    from app.flags import output_path, schema_value
     from engine.nodes.rd_topopt import PRESETS as NODE_PRESETS
 
+    output_path("--out", args.out, (".png", ".stl"))
     suffix = Path(args.out).suffix.lower()
-    if suffix not in (".png", ".stl"):
-        raise _BadInput(f"--out {args.out}: expected a .png (2D) or .stl (3D) file")
     res = parse_size(args.res, "--res") if args.res else []
     grow = parse_size(args.grow_res, "--grow-res") if args.grow_res else []
     if args.fields:
         from engine.rd.field_io import load_fields
 
         if Path(args.fields).suffix.lower() not in (".npz", ".vti"):
-            raise _BadInput(f"--fields {args.fields}: expected an .npz or .vti file")
-        try:
-            dim = load_fields(args.fields).ndim
-        except ValueError as exc:
-            raise _BadInput(f"--fields: {exc}") from None
+            raise _BadInput(f"--fields {args.fields}: expected an .npz or .vti file (allowed: .npz, .vti)")
         if res:
             raise _BadInput(f"--res {args.res}: the fields come from --fields; set the growth grid with --grow-res")
+        try:
+            fields = load_fields(args.fields)
+        except ValueError as exc:
+            raise _BadInput(f"--fields {args.fields}: {exc}") from None
+        dim = fields.ndim
     else:
         dim = NODE_PRESETS[args.preset][1]
         res = res or list(NODE_PRESETS[args.preset][2])
@@ -103,15 +148,25 @@ def _check_args(args) -> dict:
         raise _BadInput(f"--grow-res {args.grow_res}: the fields are {dim}D; give {'WxH' if dim == 2 else 'WxHxD'}")
     if (suffix == ".png") != (dim == 2):
         raise _BadInput(f"--out {args.out}: a {dim}D lattice is written as {'.png' if dim == 2 else '.stl'}")
-    for flag, value, lo in (("--max-iter", args.max_iter, 1), ("--max-steps", args.max_steps, 1)):
-        if value is not None and value < lo:
-            raise _BadInput(f"{flag} {value}: expected an integer >= {lo}")
-    if args.gamma is not None and not 1e-3 <= args.gamma <= 100.0:
-        raise _BadInput(f"--gamma {args.gamma}: expected a reaction speed in [0.001, 100]")
-    if args.iso is not None and not 0.0 < args.iso < 1.0:
-        raise _BadInput(f"--iso {args.iso}: expected a level in (0, 1)")
+    # every range is the schema of the node the flag sets
+    if args.max_iter is not None:
+        schema_value("--max-iter", args.max_iter, "TopOpt", "max_iter")
+    if args.max_steps is not None:
+        schema_value("--max-steps", args.max_steps, "RDGrow", "max_steps")
+    if args.gamma is not None:
+        args.gamma = schema_value("--gamma", args.gamma, "RDGrow", "gamma")
+    if args.iso is not None:
+        args.iso = schema_value("--iso", args.iso, "RDCompile", "iso")
     if args.seed < 0:
-        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0")
+        raise _BadInput(f"--seed {args.seed}: expected an integer >= 0 (allowed: 0, 1, 2, ...)")
+    if grow:
+        _check_grids(args, res, grow, dim)
+    elif args.fields:
+        from engine.graph import node_type
+
+        from app.flags import memory_value
+        shape = list(fields.rho.shape[::-1])      # growth on the fields' grid
+        memory_value("--fields", args.fields, node_type("RDGrow").memory_estimate({"resolution": shape}))
     return {"res": res, "grow": grow, "suffix": suffix}
 
 
@@ -168,10 +223,10 @@ def _evaluate(doc):
             raise _Failed("evaluation did not finish")
         first = failed[0]
         node = doc.nodes[first.node_id]
-        # a refused parameter of the graph we built is a refused argument
-        code = _BadInput if first.where in _ARG_OF.get(node.type_name, {}) or first.where == "path" else _Failed
+        # every argument was checked up front: a node failing now failed on valid
+        # arguments (exit 1); the message names the flag that set what it refused
         flag = _ARG_OF.get(node.type_name, {}).get(first.where, "--fields" if first.where == "path" else "")
-        raise code(f"{flag + ': ' if flag else ''}{first.error}")
+        raise _Failed(f"{flag + ': ' if flag else ''}{first.error}")
     return report
 
 
@@ -230,6 +285,8 @@ def _write(report, path, suffix) -> None:
 
 
 def run(args) -> int:
+    from app.flags import FlagError
+
     t0 = time.perf_counter()
     try:
         checked = _check_args(args)
@@ -237,14 +294,15 @@ def run(args) -> int:
         report = _evaluate(doc)
         _write(report, args.out, checked["suffix"])
         info = summary(report, out_path=args.out)
-    except _BadInput as exc:
+    except (_BadInput, FlagError) as exc:
         return _fail(str(exc), 2)
     except _Failed as exc:
         return _fail(str(exc), 1)
     except OSError as exc:
         return _fail(f"--out {args.out}: cannot write: {exc}", 1)
     except KeyboardInterrupt:
-        print(file=sys.stderr)
+        if sys.stderr.isatty():      # end the \r progress line
+            print(file=sys.stderr)
         return _fail(f"interrupted; {args.out} was not written", 130)
     info["total_seconds"] = time.perf_counter() - t0
     if args.json:

@@ -582,6 +582,9 @@ class MainWindow(QtWidgets.QMainWindow):
         if tiles == 1 or not solid.periodic:
             return np.asarray(solid.vertices), np.asarray(solid.faces)
         from engine.geometry.marching import periodic_mesh
+        from engine.memory import check_budget, tiled_mesh_bytes
+        check_budget(tiled_mesh_bytes(solid.sdf.shape, (tiles,) * 3, len(solid.faces)),
+                     what=f"exporting {tiles}x{tiles}x{tiles} cells", lower="the tiles or the resolution")
         # One marching-cubes pass over the tiled field gives a watertight block
         # (copies of the cell mesh would leave duplicate seams).
         return periodic_mesh(solid.sdf, tiles=(tiles, tiles, tiles), cell_size=solid.cell_size, cell=solid.cell)

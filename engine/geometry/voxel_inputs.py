@@ -30,16 +30,17 @@ the xx-xy and yy-xy couplings change sign.
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import numpy as np
 from numba import njit
 
+from engine.memory import MemoryLimitError, available_memory_bytes, memory_budget
+
 from .cancel import run_chunked
 
 __all__ = ["load_voxel_grid", "voxelize_mesh", "validate_density", "memory_estimate_bytes",
-           "check_memory", "available_memory_bytes", "GridTooLarge", "INPUT_SUFFIXES"]
+           "check_memory", "available_memory_bytes", "GridTooLarge", "INPUT_SUFFIXES", "grid_shape_of"]
 
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".3mf")
 INPUT_SUFFIXES = (".npy", ".vti", ".png") + MESH_SUFFIXES
@@ -53,10 +54,15 @@ LUMINANCE_THRESHOLD = 0.5
 # guess on the safe side, to be calibrated against the solver's peak.
 BYTES_PER_DOF = 2000
 BYTES_PER_CELL = 64
+# The solver's all-solid peak per degree of freedom, from the calibrated model
+# of engine.physics.periodic_fe (~2.6 kB per voxel in 3D, ~0.9 kB per pixel in
+# 2D, i.e. at most 870 B per dof): what `mesoforge homogenize` and the Material
+# Matrix node check against the budget.
+SOLVER_BYTES_PER_DOF = 900
 
 
-class GridTooLarge(ValueError):
-    """The solver would need more memory than the machine has available."""
+class GridTooLarge(MemoryLimitError):
+    """The solver would need more memory than the budget (:mod:`engine.memory`)."""
 
 
 # ----------------------------------------------------------------- checks
@@ -162,21 +168,6 @@ def memory_estimate_bytes(shape, *, per_dof_bytes=BYTES_PER_DOF, solid_fraction=
     return int(math.ceil(len(s) * cells * frac * per_dof + cells * BYTES_PER_CELL))
 
 
-def available_memory_bytes():
-    """Memory available to a new process (``MemAvailable``), or None if unknown."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def _shape_text(s):
     if len(set(s)) == 1:
         return f"{s[0]}^{len(s)}"
@@ -194,7 +185,8 @@ def check_memory(shape, *, limit_bytes=None, per_dof_bytes=BYTES_PER_DOF, solid_
     ----------
     shape : tuple of 2 or 3 int
     limit_bytes : int, optional
-        Defaults to :func:`available_memory_bytes`; when that is unknown the
+        Defaults to :func:`engine.memory.memory_budget` (the available
+        memory or ``MESOFORGE_MEMORY_LIMIT``); when that is unknown the
         check passes.
     per_dof_bytes, solid_fraction : see :func:`memory_estimate_bytes`
 
@@ -210,10 +202,11 @@ def check_memory(shape, *, limit_bytes=None, per_dof_bytes=BYTES_PER_DOF, solid_
         available".
     """
     need = memory_estimate_bytes(shape, per_dof_bytes=per_dof_bytes, solid_fraction=solid_fraction)
-    limit = available_memory_bytes() if limit_bytes is None else int(limit_bytes)
+    limit = memory_budget() if limit_bytes is None else int(limit_bytes)
     if limit is not None and need > limit:
         raise GridTooLarge(f"a {_shape_text(_check_shape(shape))} grid needs about {_gb(need)}, "
-                           f"more than the {_gb(limit)} available; use a coarser resolution")
+                           f"more than the {_gb(limit)} available; use a coarser resolution",
+                           need=need, budget=limit, lower="the resolution", where="resolution")
     return need
 
 
@@ -462,6 +455,62 @@ def _read_mesh(path, res, bounds, progress):
             "mesh_volume": abs(float(mesh.volume)),
             "mesh_volume_fraction": abs(float(mesh.volume)) / box}
     return grid, info
+
+
+def _npy_shape(path):
+    try:
+        return tuple(np.load(path, mmap_mode="r", allow_pickle=False).shape)
+    except Exception:  # noqa: BLE001 - object arrays, bad headers: the reader says why
+        return None
+
+
+def _vti_shape(path):
+    import re
+
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16).decode("latin-1")
+    m = re.search(r'WholeExtent\s*=\s*"([^"]*)"', head)
+    try:
+        ext = [int(v) for v in m.group(1).split()] if m else []
+    except ValueError:
+        return None
+    if len(ext) != 6:
+        return None
+    dims = tuple(ext[2 * a + 1] - ext[2 * a] + 1 for a in range(3))  # points: the larger reading
+    return dims if dims[2] > 1 else (dims[1], dims[0])
+
+
+def _png_shape(path):
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            return (int(im.size[1]), int(im.size[0]))
+    except Exception:  # noqa: BLE001 - the reader says why
+        return None
+
+
+def grid_shape_of(path, *, res=None):
+    """The grid shape :func:`load_voxel_grid` would return, read from the file's
+    header (nothing is loaded), so that a grid too large for memory is refused
+    first; None when the header cannot tell (the reader then reports the file).
+
+    ``.npy``: the array's shape; ``.vti``: the point dimensions of
+    ``WholeExtent`` (one voxel per point, the larger of the two readings);
+    ``.png``: (rows, columns); meshes: ``(res,) * 3`` (default 100).
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if not p.is_file():
+        return None
+    if suffix in MESH_SUFFIXES:
+        n = DEFAULT_MESH_RES if res is None else int(res)
+        return (n, n, n)
+    try:
+        reader = {".npy": _npy_shape, ".vti": _vti_shape, ".png": _png_shape}.get(suffix)
+        return None if reader is None else reader(p)
+    except OSError:
+        return None
 
 
 def load_voxel_grid(path, *, res=None, invert=False, array=None, bounds=None, progress=None):

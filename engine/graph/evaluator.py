@@ -309,6 +309,7 @@ class Evaluator:
         t0 = time.perf_counter()
         try:
             ctx.check()
+            cls.check_memory(params, inputs)  # refused before anything is allocated
             outputs = cls().evaluate(inputs, params, ctx)
             ctx.check()
         except Cancelled as exc:

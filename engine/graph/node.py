@@ -123,6 +123,9 @@ class NodeType:
     # encode_state / decode_state that result is also kept in the project file
     stateful: ClassVar[bool] = False
     max_per_graph: ClassVar[int | None] = None
+    # the parameter that sets the size of the work: what to lower when the
+    # memory estimate exceeds the budget (see memory_estimate)
+    memory_param: ClassVar[str] = ""
 
     def evaluate(self, inputs: dict[str, Any], params: dict[str, Any], ctx: EvalContext) -> dict[str, Any]:
         raise NotImplementedError
@@ -134,6 +137,32 @@ class NodeType:
         "" when the node reads nothing outside the graph (or it is unreadable:
         evaluate() then reports the problem)."""
         return ""
+
+    # -- memory -------------------------------------------------------------
+    @classmethod
+    def memory_estimate(cls, params: dict[str, Any], inputs_shape_info: dict[str, Any] | None = None) -> int:
+        """Peak bytes an evaluation with these (validated) parameters allocates.
+
+        ``inputs_shape_info`` is the dict of input values when the inputs are
+        known (the evaluator passes them), None before anything is evaluated
+        (the command line checks a graph up front): an estimate that needs an
+        input's size then counts only what the parameters tell.  Must be cheap
+        (no allocation proportional to the estimate).  0 = negligible.
+        """
+        return 0
+
+    @classmethod
+    def check_memory(cls, params: dict[str, Any], inputs_shape_info: dict[str, Any] | None = None) -> int:
+        """``memory_estimate``, refused with ``engine.memory.MemoryLimitError``
+        (naming ``memory_param`` and its value) when it exceeds the budget."""
+        from engine.memory import check_budget
+
+        need = int(cls.memory_estimate(params, inputs_shape_info))
+        if need <= 0:
+            return 0
+        name = cls.memory_param
+        what = f"{name} = {params.get(name)!r}" if name else "this evaluation"
+        return check_budget(need, what=what, lower=name, where=name)
 
     # -- stored state (stateful nodes) ------------------------------------
     def encode_state(self, outputs: dict[str, Any]) -> dict | None:

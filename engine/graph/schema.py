@@ -200,6 +200,18 @@ class Param:
         except ValueError as exc:
             raise ParamError(self.name, _shown(value), str(exc)) from None
 
+    def allowed(self) -> str:
+        """What `coerce` accepts, in words for messages: ``"[0.01, 0.99]"``,
+        ``"integers in [2, 4096]"``, ``"one of x, y, z"``..."""
+        lo = "-inf" if self.minimum is None else f"{self.minimum:g}"
+        hi = "inf" if self.maximum is None else f"{self.maximum:g}"
+        rng = f"[{lo}, {hi}]"
+        return {"float": f"a finite number in {rng}", "int": f"an integer in {rng}",
+                "bool": "true or false", "enum": "one of " + ", ".join(map(str, self.choices)),
+                "str": "text", "vec3": f"three numbers in {rng}", "int_list": f"integers in {rng}",
+                "samples": f"[t, value] pairs, t in [0, 1], value in {rng}",
+                "json": "JSON data"}[self.kind]
+
     def to_dict(self) -> dict:
         """Describe the parameter for UIs and documentation."""
         return {

@@ -20,11 +20,17 @@ from engine.growth.regions import parse_region_hints, parse_region_map, region_h
 from engine.growth.regrow import regrow_region, regrowth_start
 from engine.growth.tiling import UNASSIGNED
 from engine.growth.tiling_io import tiling_from_dict, tiling_to_dict
-from engine.growth.properties import VOID_MODES, homogenize_tiling
+from engine.geometry.voxel_inputs import SOLVER_BYTES_PER_DOF, memory_estimate_bytes
+from engine.growth.properties import DEFAULT_RESOLUTION, VOID_MODES, homogenize_tiling
 
 from .properties import stiffness_from_result
 
 MAX_CELLS = 1_000_000
+# Peak bytes per grid cell of a growth: the wave (possible tiles per cell),
+# entropies, the recorded steps and the tiling; measured 92-129 B for TL+-
+# (11 tiles) and cubic-beams-mixed (71 tiles), so a base plus a little per tile.
+GROW_BYTES_PER_CELL = 128
+GROW_BYTES_PER_CELL_TILE = 2
 REGROW_MARGIN = 1  # cells cleared around a repainted region (square neighbourhood)
 
 
@@ -122,6 +128,14 @@ class GrowNode(NodeType):
         Param("region_hints", "str", "",
               doc="hints per painted label, e.g. '1: T=3,+=1 | 2: L=2'; label 0 uses `hints`"),
     )
+
+    memory_param = "size"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        ts = (inputs_shape_info or {}).get("tileset")
+        n_tiles = 0 if ts is None else len(ts.tile_names)
+        return math.prod(params["size"]) * (GROW_BYTES_PER_CELL + GROW_BYTES_PER_CELL_TILE * n_tiles)
 
     def evaluate(self, inputs, params, ctx):
         ts = inputs["tileset"]
@@ -293,6 +307,13 @@ class TilingPropertiesNode(NodeType):
               doc="removed: void carries nothing; soft: E_v = 1e-3 E (paper)"),
     )
 
+    memory_param = "resolution"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        tv = (inputs_shape_info or {}).get("tiling")
+        return 0 if tv is None else tiling_properties_bytes(tv.tiling.shape, params["resolution"])
+
     def evaluate(self, inputs, params, ctx):
         tv = inputs["tiling"]
         res = params["resolution"] or None
@@ -308,3 +329,11 @@ class TilingPropertiesNode(NodeType):
         n = res or (20 if tv.ndim == 2 else 10)
         return {"stiffness": stiffness_from_result(result, E=params["E"], nu=params["nu"],
                                                    rho=params["rho"], resolution=n)}
+
+
+def tiling_properties_bytes(shape, resolution: int = 0) -> int:
+    """Peak bytes of homogenizing a tiling of grid ``shape`` (blocks) at
+    ``resolution`` pixels / voxels per block edge (0 = the default): the
+    homogenization model of ``engine.geometry.voxel_inputs`` on its image."""
+    n = resolution or DEFAULT_RESOLUTION[len(shape)]
+    return memory_estimate_bytes(tuple(int(b) * n for b in shape), per_dof_bytes=SOLVER_BYTES_PER_DOF)

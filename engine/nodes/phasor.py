@@ -31,6 +31,32 @@ DEFAULT_SPEC_TEXT = json.dumps(DEFAULT_SPEC)
 SHOW = ("diamonds", "p_v", "p_w", "singularity")
 SHOW_S_MAX = 10.0  # singularity images are clipped here (inf where G = 0) for display
 MAX_FIELD_CELLS = 256 ** 3
+# Peak bytes per control-field cell (D as a 3x3 frame, F, Gamma, the stroke
+# weights and their temporaries) and per slice pixel (the sample points, the
+# complex noise of both families, the sawtooth, inside and diamond masks).
+FIELD_BYTES_PER_CELL = 160
+SLICE_BYTES_PER_PIXEL = 160
+# Per layer of a whole print, per pixel along the slice's edges: the toolpaths
+# kept for the G-code and the printability emulation.
+PRINT_BYTES_PER_EDGE_PIXEL = 64
+
+
+def slice_pixels(lo, hi, axis: str, pixel: float) -> int:
+    """Pixels of the slice normal to ``axis`` over the box lo..hi (mm) at ``pixel`` mm."""
+    ext = np.abs(np.asarray(hi, float) - np.asarray(lo, float))
+    u, v = [a for a in range(3) if a != "xyz".index(axis)]
+    return int(math.ceil(ext[u] / pixel) + 1) * int(math.ceil(ext[v] / pixel) + 1)
+
+
+def print_memory_estimate(lo, hi, pixel: float, layer_height: float) -> int:
+    """Peak bytes of slicing a whole print (every layer of ``layer_height`` mm
+    at ``pixel`` mm, as ``mesoforge phasor --gcode`` / ``--printability`` do):
+    one z slice at a time, plus the toolpaths kept per layer."""
+    ext = np.abs(np.asarray(hi, float) - np.asarray(lo, float))
+    layers = int(math.ceil(ext[2] / layer_height))
+    edge = int(math.ceil((ext[0] + ext[1]) / pixel))
+    return (slice_pixels(lo, hi, "z", pixel) * SLICE_BYTES_PER_PIXEL
+            + layers * edge * PRINT_BYTES_PER_EDGE_PIXEL)
 
 
 def _canonical_strokes(data):
@@ -143,6 +169,13 @@ class PhasorFieldsNode(NodeType):
         Param("strokes", "json", [], check=_canonical_strokes,
               doc="painted brush strokes, in order (Stroke.to_dict)"),
     )
+
+    memory_param = "resolution"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        n = params["resolution"]
+        return n ** 3 * FIELD_BYTES_PER_CELL   # the longest axis gets n cells, the others at most n
 
     def evaluate(self, inputs, params, ctx):
         domain = inputs.get("domain")
@@ -341,6 +374,16 @@ class PhasorSliceNode(NodeType):
         Param("engine", "enum", "gpu", choices=("gpu", "numpy"),
               doc="gpu: the shader (numpy when no EGL context can be made, logged); numpy: reference"),
     )
+
+    memory_param = "pixel"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        infill = (inputs_shape_info or {}).get("infill")
+        if infill is None:
+            return 0   # the box comes with the infill
+        f = infill.fields
+        return slice_pixels(f.lo, f.hi, params["axis"], params["pixel"]) * SLICE_BYTES_PER_PIXEL
 
     def evaluate(self, inputs, params, ctx):
         from engine.phasor.infill import SINGULARITY_THRESHOLD, check_pixel, infill_slice

@@ -6,6 +6,7 @@ import numpy as np
 
 from engine.geometry.box_cell import box_grid_shape
 from engine.geometry.resample import resample_periodic
+from engine.geometry.voxel_inputs import SOLVER_BYTES_PER_DOF, memory_estimate_bytes
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.graph.values import Stiffness
@@ -50,6 +51,24 @@ class MaterialMatrixNode(NodeType):
               doc="voxels along the longest cell edge for the solve (0 = the Object grid as is); "
                   "the paper used 100"),
     )
+
+    memory_param = "resolution"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        """The homogenization solve of the grid (``memory_estimate_bytes``, the
+        one model ``mesoforge homogenize`` uses too); resolution 0 needs the
+        Voxel input's grid, unknown before it is evaluated."""
+        vox = (inputs_shape_info or {}).get("voxels")
+        n = params["resolution"]
+        cell = (1.0, 1.0, 1.0) if vox is None else tuple(vox.solid.cell)
+        if n:
+            shape = box_grid_shape(cell, n)
+        elif vox is not None:
+            shape = np.shape(vox.occupancy)
+        else:
+            return 0
+        return memory_estimate_bytes(shape, per_dof_bytes=SOLVER_BYTES_PER_DOF)
 
     def evaluate(self, inputs, params, ctx):
         vox = inputs["voxels"]

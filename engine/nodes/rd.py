@@ -29,6 +29,12 @@ from engine.graph.values import ContourValue, Field, RDFieldsValue, Solid
 from . import rd_state
 
 MAX_FIELD_CELLS = 4_000_000      # growth grid: 2000 x 2000 or 160^3
+# Peak bytes per growth-grid cell, by dimension: upsampled fields, the
+# diffusion tensors, u and v, the grown pattern per direction (a 2D run
+# measured ~300 B per cell, a 3D one ~2.6 kB, compilation included), and of
+# the compilation alone.
+GROW_BYTES_PER_CELL = {2: 400, 3: 2800}
+COMPILE_BYTES_PER_CELL = {2: 100, 3: 700}
 DIRECTIONS = ("all", "first", "second", "third")
 SEEDS = ("centre", "several")
 COMBINE = ("union", "lattice", "membrane")
@@ -322,6 +328,18 @@ class RDGrowNode(NodeType):
               doc="brush edits [{mode: erase|draw, centre: [x, y(, z)], radius}] in growth-grid cells"),
     )
 
+    memory_param = "resolution"
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        source = (inputs_shape_info or {}).get("rdfields")
+        res = list(params["resolution"])
+        if not res and source is None:
+            return 0
+        shape = res if res else source.grid_shape
+        d = len(shape) if len(shape) in (2, 3) else 3
+        return math.prod(shape) * GROW_BYTES_PER_CELL[d]
+
     def evaluate(self, inputs, params, ctx):
         source = inputs["rdfields"]
         shape = growth_shape(params["resolution"], source)
@@ -411,6 +429,14 @@ class RDCompileNode(NodeType):
               doc="union (2D), lattice (3D pairwise intersections then union) or membrane (3D, "
                   "lattice plus the first two families whole)"),
     )
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        st = (inputs_shape_info or {}).get("structures")
+        if st is None:
+            return 0
+        shape = st.fields.grid_shape
+        return math.prod(shape) * COMPILE_BYTES_PER_CELL[3 if len(shape) == 3 else 2]
 
     def evaluate(self, inputs, params, ctx):
         from engine.rd.compile import compile_structure, structure_contours, structure_mesh

@@ -14,6 +14,13 @@ from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.graph.values import Solid, VoxelModel
 
+# Peak bytes per grid point of an Object evaluation: the float64 distance field
+# of each batch, their union and the marching-cubes mesh (a beam cell measured
+# 24 B at 64^3 and 128^3; doubled for surface batches next to line ones).
+OBJECT_BYTES_PER_POINT = 48
+# CSG of solids on one grid: the reduced field and its mesh.
+CSG_BYTES_PER_POINT = 32
+
 
 def _solid_from_sdf(sdf: np.ndarray, cell_size: float, progress=None, cell=(1.0, 1.0, 1.0)) -> Solid:
     if not np.any(sdf < 0):
@@ -49,14 +56,26 @@ class ObjectNode(NodeType):
               doc="box edges (Lx, Ly, Lz) of the periodic cell; hexagonal: (1, 1.7320508, c)"),
     )
 
+    memory_param = "resolution"
+
+    @classmethod
+    def grid_shape(cls, params) -> tuple:
+        """Grid nodes per axis (x, y, z) of the cell box at ``resolution``."""
+        # the schema keeps each edge in [1e-3, MAX_EDGE]; direct callers may leave it out
+        cell = tuple(float(v) for v in params.get("cell", (1.0, 1.0, 1.0)))
+        return box_grid_shape(cell, params["resolution"])
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        return int(np.prod(cls.grid_shape(params), dtype=np.int64)) * OBJECT_BYTES_PER_POINT
+
     def evaluate(self, inputs, params, ctx):
         skel = inputs["skeleton"]
         if not skel.elements:
             raise NodeInputError("the skeleton is empty", where="skeleton")
         method = params["extrusion"]
-        # the schema keeps each edge in [1e-3, MAX_EDGE]; direct callers may leave it out
         cell = tuple(float(v) for v in params.get("cell", (1.0, 1.0, 1.0)))
-        shape = box_grid_shape(cell, params["resolution"])
+        shape = self.grid_shape(params)
         fields = []
         lines = skel.lines
         if lines:
@@ -95,6 +114,11 @@ class CSGBooleanNode(NodeType):
     inputs = (Port("solids", "Solid", multi=True),)
     outputs = (Port("solid", "Solid"),)
     params = (Param("operation", "enum", "union", choices=("union", "intersection", "difference")),)
+
+    @classmethod
+    def memory_estimate(cls, params, inputs_shape_info=None) -> int:
+        solids = (inputs_shape_info or {}).get("solids") or []
+        return max((int(np.size(s.sdf)) for s in solids), default=0) * CSG_BYTES_PER_POINT
 
     def evaluate(self, inputs, params, ctx):
         solids = inputs["solids"]

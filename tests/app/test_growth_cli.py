@@ -44,7 +44,7 @@ def test_grow_3d_and_text_output(tmp_path, capsys):
 
 @pytest.mark.parametrize("args, match", [
     (["grow", "nope", "--size", "4x4"], "TILESET 'nope'"),
-    (["grow", "TL+-", "--size", "0x4"], "--size '0x4': every count must be >= 1"),
+    (["grow", "TL+-", "--size", "0x4"], "--size '0x4': every count must be in [1, 1000]"),
     (["grow", "TL+-", "--size", "4x4x4"], "--size '4x4x4': the tile set is 2D"),
     (["grow", "TL+-", "--size", "4by4"], "--size '4by4'"),
     (["grow", "TL+-", "--size", "4x4", "--hints", "T=1,X=2"], "--hints: hints entry 2 'X=2'"),
@@ -54,7 +54,8 @@ def test_grow_3d_and_text_output(tmp_path, capsys):
     (["study", "TL+-", "--hints", "T=x"], "weight 'x' is not a number"),
     (["study", "TL+-", "--size", "3x0"], "--size '3x0'"),
     (["study", "TL+-", "--size", "3x3", "--n", "1", "--out", "s.txt",
-      "--scheduler", "synchronous"], "must end in .csv"),
+      "--scheduler", "synchronous"], "--out s.txt: unsupported extension '.txt' (allowed: a file "
+                                      "ending in .csv, .parquet)"),
 ])
 def test_bad_input_exits_2_naming_it(tmp_path, capsys, args, match):
     if args[0] == "grow" and "--out" not in args:

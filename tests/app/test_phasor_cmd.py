@@ -112,10 +112,10 @@ def test_the_noise_node_is_found_or_named(tmp_path, capsys):
     (["--slice", "z=0.5", "--json", "--px", "0.5"], "--px 0.5: pixel 0.5 mm is too coarse"),
     (["--png", "x.png"], "--png needs --slice"),
     ([], "nothing to do"),
-    (["--gcode", "x.gcode", "--layer", "0.6"], "--layer: layer_height"),
+    (["--gcode", "x.gcode", "--layer", "0.6"], "--layer 0.6: layer_height"),
     (["--gcode", "x.gcode", "--px", "0.25"], "below half the nozzle"),
     (["--printability", "--px", "0.25"], "below half the nozzle"),
-    (["--printability", "--nozzle", "-1"], "--nozzle: nozzle_diameter"),
+    (["--printability", "--nozzle", "-1"], "--nozzle -1.0: nozzle_diameter"),
 ])
 def test_bad_arguments_exit_2_naming_them(project, capsys, args, match):
     path, _ = project

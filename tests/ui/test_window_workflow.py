@@ -144,3 +144,17 @@ def test_export_mesh_uses_current_tiling(window, tmp_path, strut_graph, wait_eva
     assert one.stat().st_size > 0 and three.stat().st_size > 0
     assert not window.export_mesh(tmp_path / "cell.xyz")  # refused with a message
     assert window.prompter.errors
+
+
+def test_export_too_large_for_memory_is_refused_before_meshing(window, tmp_path, strut_graph, wait_eval,
+                                                               monkeypatch):
+    strut_graph(window.undo)
+    wait_eval(window, 0)
+    window.act_tiling.setChecked(True)
+    monkeypatch.setenv("MESOFORGE_MEMORY_LIMIT", "1M")    # the 3x3x3 block needs far more
+    import engine.geometry.marching as marching
+    monkeypatch.setattr(marching, "periodic_mesh", lambda *a, **k: pytest.fail("meshed anyway"))
+    out = tmp_path / "block.stl"
+    assert not window.export_mesh(out)
+    assert not out.exists()
+    assert "memory" in window.prompter.errors[-1][1] and "tiles" in window.prompter.errors[-1][1]
