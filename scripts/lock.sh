@@ -11,12 +11,15 @@ trap 'rm -rf "$tmp"' EXIT
 "$PY" -m venv "$tmp/venv"
 "$tmp/venv/bin/python" -m pip install -q --upgrade pip
 "$tmp/venv/bin/python" -m pip install -q -e ".[test]"
+# the build backend pyproject.toml asks for, pinned for the editable build too
+"$tmp/venv/bin/python" -m pip install -q --upgrade "setuptools>=77"
 {
   echo "# Pinned versions of every package scripts/setup.sh installs (the test extras"
-  echo "# included); pyproject.toml keeps the ranges.  Made by scripts/lock.sh with"
+  echo "# and the build backend included); pyproject.toml keeps the ranges.  Made by scripts/lock.sh with"
   echo "# $("$tmp/venv/bin/python" --version) on $(uname -m); refresh with: bash scripts/lock.sh"
   echo "pip==$("$tmp/venv/bin/python" -m pip --version | cut -d' ' -f2)"
-  "$tmp/venv/bin/python" -m pip freeze --exclude-editable | LC_ALL=C sort -f
+  echo "setuptools==$("$tmp/venv/bin/python" -c 'import setuptools; print(setuptools.__version__)')"
+  "$tmp/venv/bin/python" -m pip freeze --exclude-editable | grep -v '^setuptools==' | LC_ALL=C sort -f
 } > requirements.lock.new
 mv requirements.lock.new requirements.lock
 echo "[lock] wrote requirements.lock ($(grep -vc '^#' requirements.lock) packages)"

@@ -39,12 +39,13 @@ stamp=".venv/.mesoforge-installed"
 extra=""
 [ $want_test = 1 ] && extra="[test]"
 # Every package is installed at the version requirements.lock pins (the
-# versions the test suite passed with); pyproject.toml keeps the ranges.
+# versions the test suite passed with), the build backend of the editable
+# install included; pyproject.toml keeps the ranges.
 lock="requirements.lock"
 sig="$(cat pyproject.toml "$lock" | sha256sum | cut -c1-16)$extra"
 if [ ! -f "$stamp" ] || ! grep -qxF -- "$sig" "$stamp"; then
   echo "[setup] installing Python packages from $lock (first run takes a few minutes)"
   .venv/bin/python -m pip install -q -c "$lock" --upgrade pip
-  .venv/bin/python -m pip install -q -c "$lock" -e ".$extra"
+  .venv/bin/python -m pip install -q -c "$lock" --build-constraint "$lock" -e ".$extra"
   echo "$sig" >> "$stamp"
 fi

@@ -56,3 +56,15 @@ def test_every_installed_requirement_is_pinned_at_its_installed_version():
     assert not missing, f"not in requirements.lock (run bash scripts/lock.sh): {missing}"
     drifted = {n: (pins[n], metadata.version(n)) for n in needed if metadata.version(n) != pins[n]}
     assert not drifted, f"installed versions differ from requirements.lock: {drifted}"
+
+
+def test_the_build_backend_is_pinned_within_its_range():
+    import tomllib
+
+    pins = _locked()
+    build = tomllib.loads((LOCK.parent / "pyproject.toml").read_text())["build-system"]["requires"]
+    for text in build:
+        req = Requirement(text)
+        key = canonicalize_name(req.name)
+        assert key in pins, f"build requirement {req.name} is not in requirements.lock"
+        assert req.specifier.contains(pins[key]), f"{req.name}=={pins[key]} is outside {req.specifier}"
