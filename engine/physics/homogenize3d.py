@@ -57,7 +57,8 @@ def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
         ran an iteration faster. The result does not depend on it.
     memory_limit : float or None
         Refuse (MemoryError, with the estimate) a grid whose estimated peak
-        memory exceeds this many bytes; default 80 % of the available memory.
+        memory exceeds this many bytes; default the budget of engine.memory
+        (the available memory, or MESOFORGE_MEMORY_LIMIT).
     cell : (3,) float or None
         Box cell ``(Lx, Ly, Lz)`` (any unit, only ratios matter): the grid
         covers the box with box voxels of edges ``L_i / n_i`` (trilinear hexes

@@ -17,13 +17,13 @@ fix the axis conventions; here array axis ``a`` is lattice direction ``a``.
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from engine.geometry.cancel import _PARALLEL_LOCK, report
+from engine.memory import memory_budget
 
 from . import element_kernels as ek
 from .block_pcg import block_pcg
@@ -163,20 +163,6 @@ def check_density(density, name, ndim):
 
 # --------------------------------------------------------------------- memory
 
-def _available_memory():
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def estimate_memory(density, void_modulus=0.0):
     """Upper estimate (bytes) of the solver's peak memory for a grid.
 
@@ -238,7 +224,7 @@ def homogenize_grid(density, *, E, nu, void_modulus, tol, max_iterations, progre
     """
     t_start = time.perf_counter()
     dim = density.ndim
-    limit = memory_limit if memory_limit is not None else _limit_from_machine()
+    limit = memory_limit if memory_limit is not None else memory_budget()
     if limit is not None:
         # nodes >= elements on a periodic grid: a lower bound that needs no
         # masks refuses a huge grid before the exact count allocates them
@@ -306,11 +292,6 @@ def _parallel_guard():
         ek.column_dots(z, z, z)
         layer = numba.threading_layer()
     return _PARALLEL_LOCK if layer == "workqueue" else contextlib.nullcontext()
-
-
-def _limit_from_machine():
-    avail = _available_memory()
-    return None if avail is None else 0.8 * avail
 
 
 def _solve(density, dim, E, nu, vm, tol, max_iterations, ticker, t_start, shape_out,
