@@ -1,0 +1,91 @@
+"""Progress, cancellation, chunked loops and the parallel lock: one module for every engine package.
+
+Kernels take ``progress=None`` or a callable ``progress(done, total) -> bool``.
+Returning ``False`` asks the kernel to stop; it then raises :class:`Cancelled`.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Callable, Optional
+
+ProgressFn = Optional[Callable[[int, int], bool]]
+
+# A chunk of work between two progress calls should take about this long, so
+# that a cancel request is honoured well within the ~100 ms the UI promises.
+TARGET_CHUNK_SECONDS = 0.04
+
+
+# numba's "workqueue" threading layer (the fallback when neither TBB nor
+# OpenMP is available) aborts the process if two threads launch parallel
+# kernels at once; the UI may evaluate nodes from several worker threads.
+# Work chunks are short, so serialising them costs little.
+PARALLEL_LOCK = threading.Lock()
+_PARALLEL_LOCK = PARALLEL_LOCK  # old private name, kept until every import is rewritten
+
+
+class Cancelled(Exception):
+    """Raised by a kernel when its progress callback returned ``False``."""
+
+
+def report(progress: ProgressFn, done: int, total: int) -> None:
+    """Call ``progress(done, total)`` and raise :class:`Cancelled` on ``False``.
+
+    Parameters
+    ----------
+    progress : callable or None
+        The user's callback; ``None`` means "never cancel, report nothing".
+    done, total : int
+        Units of work finished so far and in all.
+    """
+    if progress is None:
+        return
+    answer = progress(int(done), int(total))
+    # ``None`` (a callback that forgot to return) means carry on; only an
+    # explicit falsy answer such as False / np.False_ cancels.
+    if answer is not None and not answer:
+        raise Cancelled(f"cancelled at {done}/{total}")
+
+
+def run_chunked(work: Callable[[int, int], None], total: int,
+                progress: ProgressFn, *, first_chunk: int = 2) -> None:
+    """Run ``work(start, stop)`` over ``range(total)`` in timed chunks.
+
+    Without a callback the whole range is done in one call (least overhead).
+    With one, the chunk size adapts so each call lasts about
+    ``TARGET_CHUNK_SECONDS``; the callback is consulted before and after
+    each chunk. Calls to ``work`` from different threads never overlap.
+
+    Parameters
+    ----------
+    work : callable
+        ``work(start, stop)`` processes items ``start <= i < stop``.
+    total : int
+        Number of items (e.g. grid planes).
+    progress : callable or None
+        See :func:`report`.
+    first_chunk : int
+        Size of the first, timing, chunk.
+    """
+    if progress is None:
+        with PARALLEL_LOCK:
+            work(0, total)
+        return
+    report(progress, 0, total)
+    start, chunk = 0, max(1, first_chunk)
+    while start < total:
+        stop = min(total, start + chunk)
+        with PARALLEL_LOCK:
+            t0 = time.perf_counter()
+            work(start, stop)
+            elapsed = time.perf_counter() - t0
+        start = stop
+        report(progress, start, total)
+        # Grow or shrink towards the target, but never by more than 4x at a
+        # time so one unexpectedly slow region cannot blow the latency.
+        if elapsed > 0:
+            scale = min(4.0, max(0.25, TARGET_CHUNK_SECONDS / elapsed))
+            chunk = max(1, int(chunk * scale))
+        else:
+            chunk *= 4
