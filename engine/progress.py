@@ -89,3 +89,19 @@ def run_chunked(work: Callable[[int, int], None], total: int,
             chunk = max(1, int(chunk * scale))
         else:
             chunk *= 4
+
+
+def stage(progress: ProgressFn, start: float, share: float) -> ProgressFn:
+    """A kernel's ``progress(done, total)`` mapped onto ``[start, start + share]``
+    of a bar that runs to 1 (a node with several kernel calls gives each its
+    share).  None stays None (nothing to report).
+
+    Example: ``stage(ctx.progress, 0.0, 0.5)`` for the first of two equal steps,
+    ``stage(progress, k / n, 1 / n)`` for step ``k`` of ``n``.
+    """
+    if progress is None:
+        return None
+
+    def inner(done, total):
+        return progress(start + share * done / max(total, 1), 1.0)
+    return inner
