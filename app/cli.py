@@ -4,7 +4,7 @@
     mesoforge PROJECT.json         open a project in the window
     mesoforge eval GRAPH.json [--out cell.stl] [--tile 3 3 3] [--node ID] [--resolution N] [--json]
     mesoforge render GRAPH.json --png out.png [--tile 3 3 3]
-    mesoforge homogenize INPUT [--E 1 --nu 0.45] [--res N] [--json]
+    mesoforge homogenize PROJECT.json|INPUT [--E 1 --nu 0.45] [--resolution N] [--res N] [--json]
     mesoforge grow TILESET --size 20x20 --out tiling.json [--png t.png] [--hints T=1,+=2] [--json]
     mesoforge study TILESET [--hints ...] [--n 100] [--out study.csv] [--scheduler ADDR] [--json]
     mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--printability] [--node ID]
@@ -68,7 +68,7 @@ def _progress_printer(enabled: bool):
 
 
 def _tiles(tiles, flag: str = "--tile") -> tuple:
-    from app.evaluation import MAX_TILES, check_tiles
+    from engine.tiled_mesh import MAX_TILES, check_tiles
     from app.flags import FlagError
 
     try:
@@ -105,7 +105,7 @@ def _checked_graph(graph: str, tiles, *, resolution=None, node=None, tile_flag="
 
 
 def _tiled(solid, tiles, flag: str = "--tile"):
-    from app.evaluation import tiled_mesh
+    from engine.tiled_mesh import tiled_mesh
     from app.flags import memory_error
     from engine.memory import MemoryLimitError
 

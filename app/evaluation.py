@@ -2,34 +2,30 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from engine.graph import EvalReport, Evaluator, GraphDocument, SetParam, UndoStack, node_type
 from engine.graph.errors import GraphError
-from engine.graph.values import Solid, VoxelModel
-from engine.memory import MemoryLimitError, check_budget, tiled_mesh_bytes
-
-# Cells per axis of a tiled mesh (eval / render --tile, the window's export).
-MAX_TILES = 20
+from engine.graph.query import nearest_upstream, pick_node
+from engine.geometry.values import Solid, VoxelModel
+from engine.memory import MemoryLimitError, tiled_mesh_bytes
 
 
 def result_node(doc: GraphDocument, report: EvalReport, node_id: str | None = None) -> str | None:
     """The node whose solid is "the result": the given one, else the one feeding the
-    Voxel node, else the last Solid-producing node in topological order."""
+    Voxel node, else the last Solid-producing node in topological order
+    (``engine.graph.query``)."""
     if node_id is not None:
         if node_id not in doc.nodes:
             raise ValueError(f"--node: no node with id {node_id!r} (nodes: {', '.join(doc.nodes)})")
         return node_id
-    for nid, node in doc.nodes.items():
-        if node.type_name == "Voxel":
-            src = doc.inputs_of(nid, "solid")
-            if src:
-                return src[0].src
-    solids = [n for n in doc.topological_order() if isinstance(_first_output(report, n), (Solid, VoxelModel))]
-    return solids[-1] if solids else None
+    voxel = next((nid for nid, node in doc.nodes.items() if node.type_name == "Voxel"), None)
+    feeder = nearest_upstream(doc, voxel, lambda _nid: True) if voxel is not None else None
+    if feeder is not None:
+        return feeder
+    return pick_node(doc, None, lambda nid: isinstance(_first_output(report, nid), (Solid, VoxelModel)))
 
 
 def _first_output(report: EvalReport, nid: str) -> Any:
@@ -50,56 +46,6 @@ def override_resolution(doc: GraphDocument, resolution: int) -> None:
     for nid, node in doc.nodes.items():
         if node.type_name == "Object":
             stack.push(SetParam(nid, "resolution", resolution))
-
-
-@dataclass
-class MeshResult:
-    vertices: np.ndarray
-    faces: np.ndarray
-    summary: dict
-
-
-def check_tiles(tiles) -> tuple:
-    """Three whole cell counts in [1, MAX_TILES]; ValueError otherwise."""
-    t = tuple(tiles)
-    if len(t) != 3 or any(isinstance(v, bool) or int(v) != v or not 1 <= v <= MAX_TILES for v in t):
-        raise ValueError(f"tiles {list(t)}: expected three integers in [1, {MAX_TILES}]")
-    return tuple(int(v) for v in t)
-
-
-def tiled_mesh_estimate(solid: Solid, tiles) -> int:
-    """Peak bytes of `tiled_mesh` (``engine.memory.tiled_mesh_bytes`` of the
-    solid's grid and face count)."""
-    if not solid.periodic:
-        return 0
-    return tiled_mesh_bytes(np.shape(solid.sdf), tiles, len(solid.faces))
-
-
-def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:
-    """The solid's mesh tiled ``tiles`` cells per axis (copies at multiples of
-    the box, ``solid.box`` mm), with its summary; one marching-cubes pass over
-    the tiled field, so the block is watertight.  Raises MemoryLimitError
-    (before allocating) when the tiled mesh would not fit the budget."""
-    from engine.geometry.marching import periodic_mesh
-    from engine.geometry.mesh_io import mesh_summary
-
-    tiles = check_tiles(tiles)
-    check_budget(tiled_mesh_estimate(solid, tiles), what=f"tiling {'x'.join(map(str, tiles))} cells",
-                 lower="the tiles or the resolution", where="tiles")
-    if tiles == (1, 1, 1):
-        v, f = np.asarray(solid.vertices), np.asarray(solid.faces)
-    else:
-        v, f = periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size,
-                             cell=solid.cell)
-    s = mesh_summary(v, f)
-    cell_volume = solid.cell_size ** 3 if solid.is_unit_cube else float(np.prod(solid.box))
-    s["volume_fraction"] = float(s["volume"]) / (cell_volume * np.prod(tiles))
-    s["grid_volume_fraction"] = solid.volume_fraction
-    s["tiles"] = list(tiles)
-    if not solid.is_unit_cube:
-        s["cell"] = list(solid.cell)
-        s["box_mm"] = solid.box.tolist()
-    return MeshResult(v, f, s)
 
 
 # What `eval --json` tells about each Surface node's solve (from its SurfaceReport).

@@ -19,7 +19,14 @@ from engine.graph import AddNode, Connect, Evaluator, GraphDocument, UndoStack
 
 
 class GraphRunFailed(RuntimeError):
-    """The graph did not evaluate on checked arguments (exit code 1)."""
+    """The graph did not evaluate on checked arguments (exit code 1).
+
+    node_id, where : the failed node and the parameter or port it refused ("" when unknown)
+    """
+
+    def __init__(self, message: str, node_id: str = "", where: str = ""):
+        super().__init__(message)
+        self.node_id, self.where = node_id, where
 
 
 def build(seed: int, nodes: Mapping[str, tuple[str, dict]], edges=()) -> GraphDocument:
@@ -33,6 +40,20 @@ def build(seed: int, nodes: Mapping[str, tuple[str, dict]], edges=()) -> GraphDo
     for src, src_port, dst, dst_port in edges:
         stack.push(Connect(src, src_port, dst, dst_port))
     return doc
+
+
+def part_of(doc: GraphDocument, node_id: str) -> tuple[dict, list]:
+    """``(nodes, edges)`` in `build`'s form for ``node_id`` and everything it depends
+    on in ``doc`` (same ids and parameters, topological order), so that a
+    subcommand can add its own nodes below a project's and the project's stored
+    states still apply."""
+    from engine.graph.query import upstream_closure
+
+    keep = upstream_closure(doc, node_id)
+    nodes = {nid: (doc.nodes[nid].type_name, dict(doc.nodes[nid].params))
+             for nid in doc.topological_order() if nid in keep}
+    edges = [(e.src, e.src_port, e.dst, e.dst_port) for e in doc.edges if e.dst in keep]
+    return nodes, edges
 
 
 def stderr_progress(stream=None):
@@ -59,19 +80,23 @@ def end_progress_line(stream=None) -> None:
 
 
 def evaluate(doc: GraphDocument, *, flag_of: Mapping[str, Mapping[str, str]] | None = None,
-             evaluator: Evaluator | None = None, quiet: bool = False, cancel=None):
-    """Evaluate ``doc``; the EvalReport, or GraphRunFailed naming the first failed
-    node's error and (via ``flag_of[type name][parameter]``) the flag that set it."""
+             evaluator: Evaluator | None = None, quiet: bool = False, cancel=None, targets=None):
+    """Evaluate ``doc`` (only what ``targets`` need, if given); the EvalReport, or
+    GraphRunFailed naming the first failed node's error and (via
+    ``flag_of[type name][parameter]``) the flag that set it, else the parameter
+    (``error [parameter]``); ``quiet`` prints no progress (stderr kept for refusals)."""
     ev = evaluator or Evaluator()
-    report = ev.evaluate(doc, on_progress=None if quiet else stderr_progress(), cancel=cancel)
+    report = ev.evaluate(doc, targets=targets, on_progress=None if quiet else stderr_progress(), cancel=cancel)
     if not quiet:
         end_progress_line()
     if not report.ok:
-        failed = [r for r in report.results.values() if r.status == "failed"]
+        failed = [r for r in report.results.values() if r.status == "failed" and r.error]
         if not failed:
-            raise GraphRunFailed("evaluation did not finish")
+            raise GraphRunFailed("evaluation did not finish" if not report.cancelled else "cancelled")
         first = failed[0]
         node = doc.nodes[first.node_id]
-        flag = (flag_of or {}).get(node.type_name, {}).get(first.where or "", "")
-        raise GraphRunFailed(f"{flag + ': ' if flag else ''}{first.error}")
+        where = first.where or ""
+        flag = (flag_of or {}).get(node.type_name, {}).get(where, "")
+        text = f"{flag}: {first.error}" if flag else f"{first.error}{f' [{where}]' if where else ''}"
+        raise GraphRunFailed(text, first.node_id, where)
     return report

@@ -7,8 +7,13 @@
     mesoforge phasor PROJECT.json --printability [--gcode OUT.gcode] [--json] [print options as above]
 
 The project's PhasorNoise node is found automatically (``--node`` picks one
-when there are several).  Its result comes from the states stored in the
-project, so a repainted infill is sliced as it was saved.
+when there are several).  The command builds a small graph of the nodes
+that feed it (``app.graph_run.build``: the same ids, parameters and seed as
+the project) plus a PhasorSlice node for ``--slice``, and evaluates it with
+the project's stored states, so a repainted infill is sliced as it was
+saved.  Prints go through ``engine.nodes.phasor_session``, as the dock's
+export does.  ``--px`` and ``--engine`` are the PhasorSlice node's
+``pixel`` and ``engine`` (range, unit and default from its schema).
 
 ``--png`` writes the slice's black diamond cells inside the part as black
 pixels on white.  ``--json`` prints the singularity energy F_S(2) of the
@@ -30,14 +35,17 @@ that fails to evaluate exits with 1; an interrupted print with 130.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 NOISE_TYPE = "PhasorNoise"
+SLICE_NODE = "cli_slice"
+# the PhasorSlice parameters set by flags; axis and position come from --slice
+SLICE_FLAGS = {"pixel": "--px", "engine": "--engine"}
 
 
 class _BadInput(ValueError):
@@ -49,21 +57,27 @@ class _Failed(RuntimeError):
 
 
 def add_parsers(sub) -> None:
+    from app.schema_flags import add_param_flags
+    from engine.fab import PrintSettings
+
+    defaults = PrintSettings()
     p = sub.add_parser("phasor", help="slice a project's phasor infill: PNG, singularity energy, G-code")
     p.add_argument("project", help="project file (.json) with a PhasorNoise node")
     p.add_argument("--node", help="the PhasorNoise node to use (when the project has several)")
     p.add_argument("--slice", metavar="AXIS=MM", help="slice plane, e.g. z=2.5 (for --png / --json)")
-    p.add_argument("--px", type=float, default=0.1, help="pixel size in mm (default 0.1)")
+    group = add_param_flags(p, "PhasorSlice", SLICE_FLAGS,
+                            help_extra={"pixel": "of the slice and of every layer of a print"})
+    p.set_defaults(phasor_slice_flags=group)
     p.add_argument("--png", help="write the slice's diamond cells (black) as a PNG")
     p.add_argument("--json", action="store_true",
                    help="print F_S(2) of the slice for the raw, aligned and aligned+filtered noise")
     p.add_argument("--gcode", help="write the print (every layer) as Marlin G-code")
-    p.add_argument("--layer", type=float, help="layer height in mm (default 0.2)")
-    p.add_argument("--nozzle", type=float, help="nozzle diameter = wall width in mm (default 0.4)")
-    p.add_argument("--perimeters", type=int, help="perimeter loops around the part (default 1)")
+    p.add_argument("--layer", type=float, help=f"layer height in mm (default {defaults.layer_height:g})")
+    p.add_argument("--nozzle", type=float,
+                   help=f"nozzle diameter = wall width in mm (default {defaults.nozzle_diameter:g})")
+    p.add_argument("--perimeters", type=int,
+                   help=f"perimeter loops around the part (default {defaults.perimeters})")
     p.add_argument("--settings", help="print settings JSON (engine.fab.PrintSettings fields)")
-    p.add_argument("--engine", choices=("gpu", "numpy"), default="gpu",
-                   help="slice evaluator (default gpu; numpy when no EGL context can be made)")
     p.add_argument("--printability", action="store_true",
                    help="emulate the print: overhang and overlap segments as histograms by length "
                         "(of the --gcode file, else of the toolpaths)")
@@ -108,25 +122,6 @@ def noise_node(doc, node_id: str | None) -> str:
     return found[0]
 
 
-def _infill(args):
-    from engine.graph import Evaluator, ProjectFileError, load_project
-
-    try:
-        doc = load_project(args.project)
-    except ProjectFileError as exc:
-        raise _BadInput(str(exc)) from None
-    nid = noise_node(doc, args.node)
-    evaluator = Evaluator()
-    evaluator.import_state(doc.node_state)
-    report = evaluator.evaluate(doc, targets=[nid])
-    if not report.ok:
-        failed = [r for r in report.results.values() if r.status not in ("evaluated", "cached")]
-        first = next((r for r in failed if r.error and r.status == "failed"), failed[0])
-        where = f" [{first.where}]" if first.where else ""
-        raise _Failed(f"{first.error or first.status}{where}")
-    return nid, report.outputs[nid]["infill"]
-
-
 def _settings(args):
     from engine.fab import PrintSettings
 
@@ -153,18 +148,8 @@ def _settings(args):
         raise _BadInput(f"{named} {value}: {text}") from None
 
 
-def _png_bytes(diamonds) -> bytes:
-    import numpy as np
-    from PIL import Image
-
-    # rows run along +v (up): flip so the picture is seen from +axis with v upwards
-    img = np.where(diamonds[::-1], 0, 255).astype(np.uint8)
-    buf = io.BytesIO()
-    Image.fromarray(img).save(buf, format="PNG")
-    return buf.getvalue()
-
-
 def _gcode_progress(stream):
+    """``progress(done, total)`` printing ``layer done/total`` and the seconds so far."""
     t0 = time.perf_counter()
 
     def cb(done, total):
@@ -177,64 +162,149 @@ def _gcode_progress(stream):
     return cb
 
 
+# ------------------------------------------------------------------ the graph
+
+def phasor_graph(doc, noise_id: str, slice_params: dict | None = None):
+    """A small document of what feeds ``noise_id`` in ``doc`` (same ids, parameters,
+    edges and seed, so stored states apply) and, with ``slice_params``, a
+    PhasorSlice node `SLICE_NODE` on its infill."""
+    from app.graph_run import build, part_of
+
+    nodes, edges = part_of(doc, noise_id)
+    if slice_params is not None:
+        nodes[SLICE_NODE] = ("PhasorSlice", slice_params)
+        edges.append((noise_id, "infill", SLICE_NODE, "infill"))
+    return build(doc.seed, nodes, edges)
+
+
+def _evaluate(evaluator, doc, targets):
+    """Evaluate ``targets`` of ``doc`` quietly (stderr is for refusals and print progress);
+    GraphRunFailed (exit 1) naming the first failed node's error and parameter."""
+    from app.graph_run import evaluate
+
+    return evaluate(doc, evaluator=evaluator, targets=targets, quiet=True)
+
+
+def _fields_box(evaluator, doc, fields_id):
+    """(lo, hi) mm of the fields' grid from the PhasorFields parameters (and the part's
+    mesh, loaded but nothing else evaluated), or None when it does not come out."""
+    from engine.graph import node_type
+    from engine.nodes.phasor_session import fields_box
+
+    node = doc.nodes[fields_id]
+    domain = None
+    mesh = doc.inputs_of(fields_id, "domain")
+    if mesh:
+        report = _evaluate(evaluator, doc, [mesh[0].src])
+        domain = report.outputs[mesh[0].src][mesh[0].src_port]
+    try:
+        return fields_box(domain, node_type(node.type_name).validate_params(node.params, fields_id))
+    except ValueError:
+        return None      # the evaluation names what is wrong
+
+
 # ------------------------------------------------------------------ the command
 
-def _slice_outputs(args, infill, out) -> None:
-    from engine.fileio import write_atomic
-    from engine.phasor.infill import STATES, infill_slice
+def _check_args(args) -> dict:
+    """Every argument checked before the project is read (FlagError / _BadInput);
+    the PhasorSlice parameters the flags set."""
+    from app.flags import distinct_outputs, output_path
+    from app.schema_flags import param_values
 
-    axis, position = parse_slice(args.slice)
+    if not (args.png is not None or args.json or args.gcode is not None or args.printability):
+        raise _BadInput("nothing to do: give --png, --json (with --slice), --gcode or --printability")
+    output_path("--png", args.png, (".png",))
+    output_path("--gcode", args.gcode, (".gcode",))
+    distinct_outputs(("--png", args.png), ("--gcode", args.gcode))
+    if (args.png or (args.json and not (args.gcode or args.printability))) and not args.slice:
+        raise _BadInput(f"{'--png' if args.png else '--json'} needs --slice AXIS=MM (e.g. z=2.5)")
+    if args.slice:
+        parse_slice(args.slice)
+    params = param_values(args, args.phasor_slice_flags, only_given=False)
+    if args.gcode or args.printability:
+        settings = _settings(args)
+        if params["pixel"] > 0.5 * settings.nozzle_diameter:
+            raise _BadInput(f"--px {params['pixel']}: the walls need a pixel below half the nozzle "
+                            f"(allowed: below {0.5 * settings.nozzle_diameter:g} mm)")
+    return params
+
+
+def _check_memory(args, box, px, settings) -> None:
+    """Refuse --px / --layer whose slices would exceed the memory budget (the
+    PhasorSlice node's estimate and the print's, over the fields' box) before any work."""
+    from app.flags import memory_value
+    from engine.graph import node_type
+    from engine.nodes.phasor import print_memory_estimate
+
+    if box is None:
+        return
+    lo, hi = box
+    if args.slice and (args.png or args.json):
+        axis, _ = parse_slice(args.slice)
+        infill = SimpleNamespace(fields=SimpleNamespace(lo=lo, hi=hi))   # the estimate reads the box only
+        need = node_type("PhasorSlice").memory_estimate({"axis": axis, "pixel": px}, {"infill": infill})
+        memory_value("--px", px, need, lower="raise --px (coarser pixels)")
+    if settings is not None:
+        need = print_memory_estimate(lo, hi, px, settings.layer_height)
+        flag, value = ("--layer", settings.layer_height) if args.layer is not None else ("--px", px)
+        memory_value(flag, value, need, lower="raise --px or --layer")
+
+
+def _check_fields(args, fields, px) -> None:
+    """Refuse a slice outside the fields' box or a pixel too coarse for their highest F."""
+    from engine.nodes.phasor_session import PhasorInfillSession
+
+    session = PhasorInfillSession(fields)
     try:
-        result = infill_slice(infill, axis, position, args.px, engine=args.engine)
+        if args.slice and (args.png or args.json):
+            session.check_slice(*parse_slice(args.slice), px)
+        elif args.gcode or args.printability:
+            session.check_pixel(px)
     except ValueError as exc:
         text = str(exc)
-        raise _BadInput(f"--px {args.px}: {text}" if text.startswith("pixel") else f"--slice {args.slice}: {text}") \
+        raise _BadInput(f"--px {px}: {text}" if text.startswith("pixel") else f"--slice {args.slice}: {text}") \
             from None
-    out["slice"] = {"axis": axis, "position": position, "pixel": args.px,
-                    "shape": list(result.plane.shape), "lo": result.lo.tolist(), "hi": result.hi.tolist(),
-                    "engine": result.engine}
+
+
+def _slice_outputs(args, session, report, out, params) -> None:
+    from engine.fileio import write_atomic
+    from engine.nodes.phasor_session import diamonds_png
+    from engine.phasor.infill import STATES
+
+    axis, position = parse_slice(args.slice)
+    image, own = report.outputs[SLICE_NODE]["image"], report.outputs[SLICE_NODE]["energy"]
+    out["slice"] = {"axis": axis, "position": position, "pixel": params["pixel"],
+                    "shape": list(image.values.shape), "lo": image.lo.tolist(), "hi": image.hi.tolist(),
+                    "engine": own.engine}
     if args.png:
         try:
-            write_atomic(args.png, _png_bytes(result.diamonds))
+            write_atomic(args.png, diamonds_png(image.values))
         except OSError as exc:
             raise _Failed(f"--png {args.png}: cannot write: {exc}") from None
         out["png"] = str(Path(args.png).resolve())
-        out["diamond_fraction"] = float(result.diamonds[result.inside].mean()) if result.inside.any() else 0.0
+        inside = session.part_mask(axis, position, params["pixel"])
+        out["diamond_fraction"] = float(image.values[inside].mean()) if inside.any() else 0.0
     if args.json:
         energy = {}
         for state in STATES:
-            r = result if state == result.state else infill_slice(infill, axis, position, args.px,
-                                                                  state=state, engine=args.engine)
-            try:
-                e = r.energy()
-            except ValueError as exc:
-                raise _BadInput(f"--slice {args.slice}: {exc}") from None
-            energy[state] = {"F_S": e["either"], "F_S_v": e["v"], "F_S_w": e["w"], "pixels": e["pixels"]}
+            e = own if state == own.state else session.energy(
+                session.slice_at(axis, position, params["pixel"], state=state, engine=params["engine"]))
+            if e.pixels == 0:
+                raise _BadInput(f"--slice {args.slice}: no pixel of the slice lies inside the part away from "
+                                "its border, so it has no singularity energy")
+            energy[state] = {"F_S": e.value, "F_S_v": e.v, "F_S_w": e.w, "pixels": e.pixels}
         out["energy"] = energy
-        out["q"] = 2.0
+        out["q"] = own.q
 
 
-def _print_settings(args, infill):
-    """PrintSettings from the arguments, with --px checked for walls."""
-    from engine.phasor.infill import check_pixel
+def _gcode_output(args, session, out, settings, params) -> None:
+    from engine.progress import Cancelled
 
-    settings = _settings(args)
-    try:
-        check_pixel(infill.fields, args.px)
-    except ValueError as exc:
-        raise _BadInput(f"--px {args.px}: {exc}") from None
-    return settings
-
-
-def _gcode_output(args, infill, out, settings) -> None:
-    from engine.geometry.cancel import Cancelled
-    from engine.phasor.infill import layer_positions, write_print
-
-    n = len(layer_positions(infill, settings.layer_height))
+    n = session.layer_count(settings.layer_height)
     print(f"slicing {n} layers of {settings.layer_height:g} mm into {args.gcode}", file=sys.stderr)
     try:
-        summary = write_print(infill, args.gcode, settings=settings, pixel=args.px, engine=args.engine,
-                              progress=_gcode_progress(sys.stderr))
+        summary = session.write_print(args.gcode, settings=settings, pixel=params["pixel"],
+                                      engine=params["engine"], progress=_gcode_progress(sys.stderr))
     except Cancelled:
         raise KeyboardInterrupt from None
     except OSError as exc:
@@ -243,7 +313,6 @@ def _gcode_output(args, infill, out, settings) -> None:
                     "extrusion_length": summary.extrusion_length, "travel_length": summary.travel_length,
                     "filament_length": summary.filament_length, "print_time": summary.print_time,
                     "settings": settings.to_dict()}
-
 
 def printability_summary(report, nozzle_diameter: float) -> dict:
     """The JSON-able totals and histograms of an :class:`engine.fab.PrintabilityReport`."""
@@ -260,18 +329,17 @@ def printability_summary(report, nozzle_diameter: float) -> dict:
             "overlap": kind(report.overlap_segments, report.overlap_histogram, report.overlap_per_layer)}
 
 
-def _printability_output(args, infill, out, settings) -> None:
-    from engine.phasor.infill import infill_toolpaths
+def _printability_output(args, session, out, settings, params) -> None:
     from engine.fab import printability, read_gcode_paths
-    from engine.geometry.cancel import Cancelled
+    from engine.progress import Cancelled
 
     try:
         if args.gcode:
             layers = read_gcode_paths(args.gcode, offset=settings.offset)
         else:
             print("slicing the toolpaths of every layer", file=sys.stderr)
-            layers = infill_toolpaths(infill, settings, pixel=args.px, engine=args.engine,
-                                     progress=_gcode_progress(sys.stderr))
+            layers = session.toolpaths(settings, pixel=params["pixel"], engine=params["engine"],
+                                       progress=_gcode_progress(sys.stderr))
         print(f"emulating the print of {len(layers)} layers", file=sys.stderr)
         report = printability(layers, nozzle_diameter=settings.nozzle_diameter,
                               progress=_gcode_progress(sys.stderr))
@@ -280,46 +348,6 @@ def _printability_output(args, infill, out, settings) -> None:
     except ValueError as exc:          # the emulation grid would be too large
         raise _Failed(f"--printability: {exc}") from None
     out["printability"] = printability_summary(report, settings.nozzle_diameter)
-
-
-def _check_args(args) -> None:
-    """Every argument checked before the project is read (FlagError / _BadInput)."""
-    from app.flags import distinct_outputs, output_path, schema_value
-
-    if not (args.png is not None or args.json or args.gcode is not None or args.printability):
-        raise _BadInput("nothing to do: give --png, --json (with --slice), --gcode or --printability")
-    output_path("--png", args.png, (".png",))
-    output_path("--gcode", args.gcode, (".gcode",))
-    distinct_outputs(("--png", args.png), ("--gcode", args.gcode))
-    if (args.png or (args.json and not (args.gcode or args.printability))) and not args.slice:
-        raise _BadInput(f"{'--png' if args.png else '--json'} needs --slice AXIS=MM (e.g. z=2.5)")
-    if args.slice:
-        parse_slice(args.slice)
-    # the pixel's range is the Phasor Slice node's, which slices the infill in a graph
-    args.px = schema_value("--px", args.px, "PhasorSlice", "pixel")
-    if args.gcode or args.printability:
-        settings = _settings(args)
-        if args.px > 0.5 * settings.nozzle_diameter:
-            raise _BadInput(f"--px {args.px}: the walls need a pixel below half the nozzle "
-                            f"(allowed: below {0.5 * settings.nozzle_diameter:g} mm)")
-
-
-def _check_memory(args, infill, settings) -> None:
-    """Refuse --px / --layer whose slices would exceed the memory budget
-    (the Phasor Slice node's estimate over the infill's box)."""
-    from app.flags import memory_value
-    from engine.graph import node_type
-    from engine.nodes.phasor import print_memory_estimate
-
-    if args.slice and (args.png or args.json):
-        axis, _ = parse_slice(args.slice)
-        need = node_type("PhasorSlice").memory_estimate({"axis": axis, "pixel": args.px}, {"infill": infill})
-        memory_value("--px", args.px, need, lower="raise --px (coarser pixels)")
-    if settings is not None:
-        f = infill.fields
-        need = print_memory_estimate(f.lo, f.hi, args.px, settings.layer_height)
-        flag, value = ("--layer", settings.layer_height) if args.layer is not None else ("--px", args.px)
-        memory_value(flag, value, need, lower="raise --px or --layer")
 
 
 def _print_text(out) -> None:
@@ -352,25 +380,52 @@ def printability_table(p: dict) -> str:
     return "\n".join(lines)
 
 
+def _run(args, out) -> None:
+    from engine.graph import Evaluator, ProjectFileError, load_project
+    from engine.graph.query import upstream_of_type
+    from engine.nodes.phasor_session import PhasorInfillSession
+
+    params = _check_args(args)
+    try:
+        project = load_project(args.project)
+    except ProjectFileError as exc:
+        raise _BadInput(str(exc)) from None
+    nid = noise_node(project, args.node)
+    slicing = bool(args.slice and (args.png or args.json))
+    axis, position = parse_slice(args.slice) if slicing else (None, None)
+    doc = phasor_graph(project, nid, {**params, "axis": axis, "position": position, "show": "diamonds"}
+                       if slicing else None)
+    settings = _settings(args) if (args.gcode or args.printability) else None
+    evaluator = Evaluator()
+    evaluator.import_state(project.node_state)
+    fields_id = upstream_of_type(doc, nid, "PhasorFields", "fields")
+    if fields_id is not None:
+        _check_memory(args, _fields_box(evaluator, doc, fields_id), params["pixel"], settings)
+        fields = _evaluate(evaluator, doc, [fields_id]).outputs[fields_id]["fields"].fields
+        _check_fields(args, fields, params["pixel"])
+    report = _evaluate(evaluator, doc, [SLICE_NODE] if slicing else [nid])
+    out.update(project=str(Path(args.project).resolve()), node=nid)
+    session = PhasorInfillSession.of_infill(report.outputs[nid]["infill"])
+    if fields_id is None:          # no fields node to check before the noise: check on the infill
+        _check_fields(args, session.fields, params["pixel"])
+    if slicing:
+        _slice_outputs(args, session, report, out, params)
+    if args.gcode:
+        _gcode_output(args, session, out, settings, params)
+    if args.printability:
+        _printability_output(args, session, out, settings, params)
+
+
 def run(args) -> int:
     from app.flags import FlagError
+    from app.graph_run import GraphRunFailed
 
     out = {}
     try:
-        _check_args(args)
-        nid, infill = _infill(args)
-        out.update(project=str(Path(args.project).resolve()), node=nid)
-        settings = _print_settings(args, infill) if (args.gcode or args.printability) else None
-        _check_memory(args, infill, settings)
-        if args.slice and (args.png or args.json):
-            _slice_outputs(args, infill, out)
-        if args.gcode:
-            _gcode_output(args, infill, out, settings)
-        if args.printability:
-            _printability_output(args, infill, out, settings)
+        _run(args, out)
     except (_BadInput, FlagError) as exc:
         return _fail(str(exc), 2)
-    except _Failed as exc:
+    except (_Failed, GraphRunFailed) as exc:
         return _fail(str(exc), 1)
     except KeyboardInterrupt:
         where = f"; {args.gcode} was not written" if args.gcode and "gcode" not in out else ""

@@ -56,7 +56,7 @@ def help_text(p, extra: str = "") -> str:
         parts.append(f"allowed: {allowed}")
     default = p.default
     if p.kind == "int_list":
-        default = "x".join(str(v) for v in default)
+        default = "x".join(str(v) for v in default) if default else "none"
     elif p.kind == "vec3":
         default = ",".join(f"{v:g}" for v in default)
     elif p.kind == "bool":
@@ -65,18 +65,23 @@ def help_text(p, extra: str = "") -> str:
         default = json.dumps(default)
     elif p.kind == "str" and default == "":
         default = '""'
-    unit = f" {p.unit}" if p.unit and p.kind in ("float", "int", "int_list", "vec3") else ""
+    unit = f" {p.unit}" if p.unit and default != "none" and p.kind in ("float", "int", "int_list", "vec3") else ""
     parts.append(f"default: {default}{unit}")
     return "; ".join(parts).replace("%", "%%")
 
 
 def add_param_flags(parser, type_name: str, params: Mapping[str, str] | Sequence[str], *,
-                    help_extra: Mapping[str, str] | None = None, dest_prefix: str = "") -> ParamFlags:
+                    help_extra: Mapping[str, str] | None = None, dest_prefix: str = "",
+                    required: Sequence[str] = (), typed: Sequence[str] = ()) -> ParamFlags:
     """Add one flag per parameter of node type ``type_name``.
 
     params : ``{parameter: flag}``, or parameter names (flag ``--name`` with ``_`` → ``-``)
     help_extra : text added to a flag's help (e.g. what the flag means on the command line)
     dest_prefix : prefix of the argparse dests (two nodes with a same-named parameter)
+    required : parameters whose flag must be given (no node default fits, e.g. a size whose
+        length depends on another input)
+    typed : float / int parameters whose parsed value (``args.<dest>``) should already be a
+        number rather than the text typed (the schema still checks it in `param_values`)
     """
     mapping = dict(params) if isinstance(params, Mapping) else {n: "--" + n.replace("_", "-") for n in params}
     extra = dict(help_extra or {})
@@ -93,7 +98,9 @@ def add_param_flags(parser, type_name: str, params: Mapping[str, str] | Sequence
         else:
             metavar = {"float": "X", "int": "N", "int_list": "NxN", "vec3": "X,Y,Z", "json": "JSON|@FILE",
                        "str": "TEXT", "samples": "JSON"}[p.kind]
-            parser.add_argument(flag, dest=dest, default=None, metavar=metavar, help=text)
+            number = {"float": float, "int": int}.get(p.kind) if name in typed else None
+            parser.add_argument(flag, dest=dest, default=None, metavar=metavar, help=text,
+                                required=name in required, **({"type": number} if number else {}))
         out.append((name, flag, dest))
     return ParamFlags(type_name, tuple(out))
 

@@ -22,7 +22,6 @@ TARGET_CHUNK_SECONDS = 0.04
 # kernels at once; the UI may evaluate nodes from several worker threads.
 # Work chunks are short, so serialising them costs little.
 PARALLEL_LOCK = threading.Lock()
-_PARALLEL_LOCK = PARALLEL_LOCK  # old private name, kept until every import is rewritten
 
 
 class Cancelled(Exception):
@@ -80,15 +79,42 @@ def run_chunked(work: Callable[[int, int], None], total: int,
             t0 = time.perf_counter()
             work(start, stop)
             elapsed = time.perf_counter() - t0
+        report(progress, stop, total)
+        chunk = next_chunk(chunk, stop - start, elapsed)
         start = stop
-        report(progress, start, total)
-        # Grow or shrink towards the target, but never by more than 4x at a
-        # time so one unexpectedly slow region cannot blow the latency.
-        if elapsed > 0:
-            scale = min(4.0, max(0.25, TARGET_CHUNK_SECONDS / elapsed))
-            chunk = max(1, int(chunk * scale))
-        else:
-            chunk *= 4
+
+
+def next_chunk(chunk: int, done: int, elapsed: float, *, most: int | None = None) -> int:
+    """Size of the next chunk of an adaptive loop (work between two progress
+    calls), aiming at ``TARGET_CHUNK_SECONDS`` per chunk.
+
+    The one rule of every chunked loop (:func:`run_chunked`, the growth loops
+    of engine.rd.growth and engine.growth.wfc): the measured rate times the
+    target, shrinking at once after a slow chunk but growing at most 4x at a
+    time, so one unexpectedly fast region cannot make the next chunk (in a
+    slow region) blow the latency a cancel waits for.
+
+    Parameters
+    ----------
+    chunk : int >= 1
+        The size asked for last time.
+    done : int >= 0
+        Units of work the last chunk did (at most ``chunk``: a loop may stop a
+        chunk early at a boundary of its own).
+    elapsed : float
+        Seconds the last chunk took; 0 or less (faster than the clock): grow 4x.
+    most : int or None
+        Upper bound on the size (e.g. the steps between two convergence checks).
+
+    Returns
+    -------
+    int, at least 1 (and at most ``most``).
+    """
+    grown = 4 * int(chunk)
+    size = grown if elapsed <= 0 else min(grown, int(done * TARGET_CHUNK_SECONDS / elapsed))
+    if most is not None:
+        size = min(size, int(most))
+    return max(1, size)
 
 
 def stage(progress: ProgressFn, start: float, share: float) -> ProgressFn:

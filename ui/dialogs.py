@@ -10,7 +10,7 @@ from pathlib import Path
 
 from PySide6 import QtWidgets
 
-from app.autosave import RecoveryItem
+from engine.autosave import RecoveryItem
 
 PROJECT_FILTER = "Mesoforge project (*.json);;All files (*)"
 MESH_FILTERS = {

@@ -2,404 +2,35 @@
 
 Every edit becomes a `SetParam` pushed on the undo stack (successive edits of
 one parameter within a second merge into one undo item, as when holding a
-spin box arrow).  A value the engine refuses is shown inline and the editor
-goes back to the document's value; the document is unchanged.  Widgets are
-refreshed from document events, so undo/redo shows up here too.  When the
-node's latest evaluation produced a `Stiffness`, a `StiffnessPanel` shows it
-under the parameters.
+spin box arrow; `ui.param_push`).  A value the engine refuses is shown inline
+and the editor goes back to the document's value; the document is unchanged.
+Widgets are refreshed from document events, so undo/redo shows up here too.
+When the node's latest evaluation produced a `Stiffness`, a `StiffnessPanel`
+shows it under the parameters.  One editor class per parameter kind lives in
+`ui.param_editors` / `ui.structured_editors`.
 """
 
 from __future__ import annotations
 
-import json
+from typing import Any
 
-import math
-import time
-from typing import Any, Callable
+from PySide6 import QtCore, QtWidgets
 
-from PySide6 import QtCore, QtGui, QtWidgets
+from engine.graph import GraphDocument, GraphError, SetLabel, UndoStack, all_node_types
+from engine.physics.values import Stiffness
 
-from engine.graph import FAMILY_COLOURS, GraphDocument, GraphError, Param, SetLabel, SetParam, UndoStack, all_node_types
-from engine.graph.values import Stiffness
-
+from .colours import STATUS_COLOURS, family_colour
+from .param_editors import (BoolEditor, EnumEditor, FloatEditor, IntEditor, IntListEditor, ParamEditor, StrEditor,
+                            Vec3Editor)
+from .param_push import MergingParamPush
 from .stiffness_panel import StiffnessPanel
-
-MERGE_SECONDS = 1.0
-
-
-class MergingParamPush:
-    """Pushes SetParam on an undo stack; quick repeats of the same parameter
-    (a spin box being scrolled) merge into one undo item."""
-
-    def __init__(self, undo):
-        self.undo = undo
-        self._last: tuple[tuple[str, str], float] | None = None
-
-    def reset(self) -> None:
-        self._last = None
-
-    def push(self, node_id: str, name: str, value: Any) -> None:
-        """Push the edit; a refused value raises GraphError and ends the merge run."""
-        key, now = (node_id, name), time.monotonic()
-        merge = (self._last is not None and self._last[0] == key and now - self._last[1] < MERGE_SECONDS
-                 and self.undo.undo_text() == f"set {node_id}.{name}")
-        try:
-            self.undo.push(SetParam(node_id, name, value), merge=merge)
-        except GraphError:
-            self._last = None
-            raise
-        self._last = (key, now)
-_BIG = 1e15
-
-
-class SciSpinBox(QtWidgets.QDoubleSpinBox):
-    """A float spin box that shows values with 6 significant digits, so both
-    1e-4 and 2e11 read well, and steps by a tenth of the value's magnitude."""
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.setDecimals(15)
-        self.setKeyboardTracking(False)
-        self.setRange(-_BIG, _BIG)
-        self.setAccelerated(True)
-
-    def textFromValue(self, value: float) -> str:
-        return f"{value:.6g}"
-
-    def valueFromText(self, text: str) -> float:
-        try:
-            return float(self._strip(text))
-        except ValueError:
-            return self.value()
-
-    def validate(self, text: str, pos: int):
-        body = self._strip(text)
-        try:
-            float(body)
-            return QtGui.QValidator.State.Acceptable, text, pos
-        except ValueError:
-            ok = all(c in "0123456789+-.eE" for c in body)
-            state = QtGui.QValidator.State.Intermediate if ok else QtGui.QValidator.State.Invalid
-            return state, text, pos
-
-    def _strip(self, text: str) -> str:
-        body = text.strip()
-        if self.suffix() and body.endswith(self.suffix().strip()):
-            body = body[: -len(self.suffix().strip())]
-        return body.strip()
-
-    def stepBy(self, steps: int) -> None:
-        a = abs(self.value())
-        step = 0.01 if a < 1e-12 else 10.0 ** (math.floor(math.log10(a)) - 1)
-        self.setValue(self.value() + steps * step)
-
-
-def _float_box(param: Param) -> SciSpinBox:
-    box = SciSpinBox()
-    box.setRange(-_BIG if param.minimum is None else param.minimum, _BIG if param.maximum is None else param.maximum)
-    if param.unit:
-        box.setSuffix(f" {param.unit}")
-    return box
-
-
-class ParamEditor(QtCore.QObject):
-    """Edits one parameter.  `edited(value)` when the user changed it; `set_value` never emits."""
-
-    edited = QtCore.Signal(object)
-
-    def __init__(self, param: Param, parent=None):
-        super().__init__(parent)
-        self.param = param
-        self.widget = self._build()
-        tip = param.doc
-        rng = self._range_text()
-        self.widget.setToolTip("\n".join(t for t in (tip, rng) if t))
-
-    def _range_text(self) -> str:
-        lo, hi = self.param.minimum, self.param.maximum
-        if lo is None and hi is None:
-            return ""
-        unit = f" {self.param.unit}" if self.param.unit else ""
-        return f"range [{'-inf' if lo is None else lo:g}, {'inf' if hi is None else hi:g}]{unit}"
-
-    def _build(self) -> QtWidgets.QWidget:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-    def set_value(self, value: Any) -> None:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-    def _blocked(self, widgets, fn: Callable[[], None]) -> None:
-        old = [w.blockSignals(True) for w in widgets]
-        try:
-            fn()
-        finally:
-            for w, o in zip(widgets, old):
-                w.blockSignals(o)
-
-
-class FloatEditor(ParamEditor):
-    def _build(self):
-        self.box = _float_box(self.param)
-        self.box.valueChanged.connect(lambda v: self.edited.emit(float(v)))
-        return self.box
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setValue(float(value)))
-
-
-class IntEditor(ParamEditor):
-    def _build(self):
-        self.box = QtWidgets.QSpinBox()
-        lo = -(2**31 - 1) if self.param.minimum is None else int(self.param.minimum)
-        hi = 2**31 - 1 if self.param.maximum is None else int(self.param.maximum)
-        self.box.setRange(lo, hi)
-        self.box.setKeyboardTracking(False)
-        self.box.setAccelerated(True)
-        if self.param.unit:
-            self.box.setSuffix(f" {self.param.unit}")
-        self.box.valueChanged.connect(lambda v: self.edited.emit(int(v)))
-        return self.box
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setValue(int(value)))
-
-
-class BoolEditor(ParamEditor):
-    def _build(self):
-        self.box = QtWidgets.QCheckBox()
-        self.box.toggled.connect(lambda v: self.edited.emit(bool(v)))
-        return self.box
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setChecked(bool(value)))
-
-
-class EnumEditor(ParamEditor):
-    def _build(self):
-        self.box = QtWidgets.QComboBox()
-        for choice in self.param.choices:
-            self.box.addItem(str(choice), choice)
-        self.box.currentIndexChanged.connect(lambda i: self.edited.emit(self.box.itemData(i)))
-        return self.box
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setCurrentIndex(max(0, self.box.findData(value))))
-
-
-class StrEditor(ParamEditor):
-    def _build(self):
-        self.box = QtWidgets.QLineEdit()
-        self.box.editingFinished.connect(lambda: self.edited.emit(self.box.text()))
-        return self.box
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setText(str(value)))
-
-
-class Vec3Editor(ParamEditor):
-    def _build(self):
-        w = QtWidgets.QWidget()
-        lay = QtWidgets.QHBoxLayout(w)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(2)
-        self.boxes = []
-        for axis in "xyz":
-            box = _float_box(Param(self.param.name, "float", 0.0, self.param.minimum, self.param.maximum))
-            box.setToolTip(axis)
-            box.setMinimumWidth(56)
-            box.valueChanged.connect(lambda _v: self.edited.emit([b.value() for b in self.boxes]))
-            lay.addWidget(box)
-            self.boxes.append(box)
-        return w
-
-    def set_value(self, value):
-        def apply():
-            for box, v in zip(self.boxes, value):
-                box.setValue(float(v))
-        self._blocked(self.boxes, apply)
-
-
-class IntListEditor(ParamEditor):
-    """Integers as text: ``0, 1, 2`` (empty for an empty list)."""
-
-    def _build(self):
-        self.box = QtWidgets.QLineEdit()
-        self.box.setPlaceholderText("e.g. 0, 1, 2")
-        self.box.editingFinished.connect(self._commit)
-        return self.box
-
-    def _commit(self):
-        text = self.box.text().strip()
-        parts = [p for p in text.replace(";", ",").replace(" ", ",").split(",") if p]
-        try:
-            self.edited.emit([int(p) for p in parts])
-        except ValueError:
-            self.edited.emit(text)  # refused by the schema with a message naming the parameter
-
-    def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setText(", ".join(str(v) for v in value)))
-
-
-class SamplesEditor(ParamEditor):
-    """A table of (t, value) rows with add / remove buttons."""
-
-    def _build(self):
-        w = QtWidgets.QWidget()
-        lay = QtWidgets.QVBoxLayout(w)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.setSpacing(2)
-        self.table = QtWidgets.QTableWidget(0, 2)
-        unit = f" ({self.param.unit})" if self.param.unit else ""
-        self.table.setHorizontalHeaderLabels(["t", f"value{unit}"])
-        self.table.horizontalHeader().setSectionResizeMode(QtWidgets.QHeaderView.ResizeMode.Stretch)
-        self.table.verticalHeader().setVisible(False)
-        self.table.setMinimumHeight(90)
-        self.table.setMaximumHeight(150)
-        self.table.cellChanged.connect(lambda _r, _c: self._commit())
-        lay.addWidget(self.table)
-        row = QtWidgets.QHBoxLayout()
-        self.add_button = QtWidgets.QPushButton("+ sample")
-        self.remove_button = QtWidgets.QPushButton("− sample")
-        self.add_button.clicked.connect(self.add_row)
-        self.remove_button.clicked.connect(self.remove_row)
-        row.addWidget(self.add_button)
-        row.addWidget(self.remove_button)
-        row.addStretch(1)
-        lay.addLayout(row)
-        return w
-
-    def rows(self) -> list:
-        out = []
-        for r in range(self.table.rowCount()):
-            cells = []
-            for c in range(2):
-                item = self.table.item(r, c)
-                text = item.text().strip() if item is not None else ""
-                try:
-                    cells.append(float(text))
-                except ValueError:
-                    cells.append(text)
-            out.append(cells)
-        return out
-
-    def _commit(self):
-        self.edited.emit(self.rows())
-
-    def add_row(self):
-        rows = self.rows()
-        if rows and all(isinstance(v, float) for v in rows[-1]):
-            t_last, v_last = rows[-1]
-            if len(rows) >= 2 and isinstance(rows[-2][0], float):
-                t_new = 0.5 * (rows[-2][0] + t_last)  # split the last interval
-            else:
-                t_new = min(1.0, t_last + 0.5)
-            rows.append([t_new, v_last])
-        else:
-            rows.append([0.5, 0.1])
-        self.edited.emit(rows)
-
-    def remove_row(self):
-        rows = self.rows()
-        r = self.table.currentRow()
-        if not rows:
-            return
-        del rows[r if 0 <= r < len(rows) else -1]
-        self.edited.emit(rows)
-
-    def set_value(self, value):
-        def apply():
-            # Items are updated in place: this may run inside the table's own
-            # cellChanged emission, when replacing the edited item is unsafe.
-            self.table.setRowCount(len(value))
-            for r, pair in enumerate(value):
-                for c, x in enumerate(pair):
-                    item = self.table.item(r, c)
-                    if item is None:
-                        self.table.setItem(r, c, QtWidgets.QTableWidgetItem(f"{x:.6g}"))
-                    else:
-                        item.setText(f"{x:.6g}")
-        self._blocked([self.table], apply)
-
-
-class JsonTextDialog(QtWidgets.QDialog):
-    """Edit JSON as text; malformed text is refused in the dialog, which stays
-    open with everything typed."""
-
-    def __init__(self, title: str, value, parent=None):
-        super().__init__(parent)
-        self.setWindowTitle(title)
-        self.value = value
-        lay = QtWidgets.QVBoxLayout(self)
-        self.text = QtWidgets.QPlainTextEdit(json.dumps(value, indent=1))
-        self.text.setMinimumSize(420, 260)
-        self.error = QtWidgets.QLabel()
-        self.error.setStyleSheet("color: #c03030;")
-        self.error.setWordWrap(True)
-        buttons = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.StandardButton.Ok
-                                             | QtWidgets.QDialogButtonBox.StandardButton.Cancel)
-        buttons.accepted.connect(self.try_accept)
-        buttons.rejected.connect(self.reject)
-        lay.addWidget(self.text, 1)
-        lay.addWidget(self.error)
-        lay.addWidget(buttons)
-
-    def try_accept(self) -> bool:
-        try:
-            self.value = json.loads(self.text.toPlainText())
-        except ValueError as exc:
-            self.error.setText(f"not valid JSON: {exc}")
-            return False
-        self.accept()
-        return True
-
-
-class JsonEditor(ParamEditor):
-    """Structured data (brush strokes, loads and supports...): shown as a summary,
-    edited as JSON text in a dialog, or cleared, each one undoable step."""
-
-    def _build(self):
-        w = QtWidgets.QWidget()
-        row = QtWidgets.QHBoxLayout(w)
-        row.setContentsMargins(0, 0, 0, 0)
-        self.value = None
-        self.label = QtWidgets.QLabel()
-        self.edit_button = QtWidgets.QPushButton("Edit…")
-        self.edit_button.clicked.connect(self.open_dialog)
-        self.clear_button = QtWidgets.QPushButton("Clear")
-        self.clear_button.clicked.connect(lambda: self.edited.emit({} if isinstance(self.value, dict) else []))
-        self.dialog: JsonTextDialog | None = None
-        row.addWidget(self.label, 1)
-        row.addWidget(self.edit_button)
-        row.addWidget(self.clear_button)
-        return w
-
-    def open_dialog(self, *, modal: bool = True) -> JsonTextDialog:
-        """The JSON text dialog; with ``modal=False`` (tests) it is shown and returned."""
-        self.dialog = JsonTextDialog(f"Edit {self.param.name}", self.value, self.widget)
-        self.dialog.accepted.connect(lambda: self.edited.emit(self.dialog.value))
-        if modal:
-            self.dialog.exec()
-        else:
-            self.dialog.show()
-        return self.dialog
-
-    def set_value(self, value):
-        self.value = value
-        if isinstance(value, list):
-            self.label.setText(f"{len(value)} item{'s' if len(value) != 1 else ''}")
-        else:
-            text = json.dumps(value)
-            self.label.setText(text if len(text) <= 60 else text[:57] + "...")
-        self.clear_button.setEnabled(isinstance(value, (list, dict)) and bool(value))
-
+from .structured_editors import JsonEditor, SamplesEditor
 
 EDITORS = {
     "float": FloatEditor, "int": IntEditor, "bool": BoolEditor, "enum": EnumEditor, "str": StrEditor,
     "vec3": Vec3Editor, "int_list": IntListEditor, "samples": SamplesEditor, "json": JsonEditor,
 }
-
-STATUS_COLOURS = {"evaluated": "#5cb85c", "cached": "#5bc0de", "failed": "#e04040",
-                  "blocked": "#e0a030", "cancelled": "#999999"}
+"""The editor class of each parameter kind (``Param.kind``)."""
 
 
 class Inspector(QtWidgets.QWidget):
@@ -491,7 +122,7 @@ class Inspector(QtWidgets.QWidget):
             return
         inst = self.doc.nodes[node_id]
         cls = all_node_types()[inst.type_name]
-        r, g, b = FAMILY_COLOURS.get(cls.family, (150, 150, 150))
+        r, g, b = family_colour(cls.family, (150, 150, 150))
         self.title.setText(f"<span style='color: rgb({r},{g},{b})'>■</span> {cls.title or inst.type_name}"
                            f" <span style='color:#9aa0a6; font-weight:normal'>({cls.family})</span>")
         self.description.setText(" ".join((cls.__doc__ or "").split()))

@@ -8,143 +8,27 @@ events.  NodeGraphQt draws some changes before telling us (a dragged pipe is
 already detached, a moved node already sits at its new place); after every
 gesture `sync_edges` reconciles the scene with the document, which also
 reverts whatever the engine refused.  NodeGraphQt's own undo stack is never
-used.
+used.  The NodeGraphQt classes (node items, the gesture-forwarding graph)
+live in `ui.node_scene`, the "Arrange nodes" layout in `ui.node_layout`.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from NodeGraphQt import BaseNode, NodeGraph
+from NodeGraphQt import BaseNode
 from NodeGraphQt.base.commands import PortConnectedCmd, PortDisconnectedCmd
 from NodeGraphQt.constants import PortTypeEnum
-from NodeGraphQt.qgraphics.node_base import NodeItem
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from engine.graph import (FAMILY_COLOURS, AddNode, Connect, Disconnect, Edge, GraphDocument, GraphError,
-                          Macro, MoveNode, RemoveNode, SetLabel, UndoStack, all_node_types)
+from engine.graph import (AddNode, Connect, Disconnect, Edge, GraphDocument, GraphError, Macro, MoveNode,
+                          RemoveNode, SetLabel, UndoStack, all_node_types)
+
+from .colours import family_shade
+from .node_layout import arrange_positions
+from .node_scene import DocumentNodeGraph, make_node_classes
 
 FAMILY_ORDER = ("topology", "skeleton", "transform", "solid", "property")
-
-# Port dot colours by value type, so compatible ends are recognisable at a glance.
-PORT_COLOURS = {
-    "Point": (240, 200, 90),
-    "EdgeChain": (245, 150, 60),
-    "Skeleton": (90, 170, 240),
-    "Solid": (110, 210, 130),
-    "Voxel": (60, 160, 90),
-    "Stiffness": (230, 100, 100),
-    "Spectrum": (230, 120, 200),
-    "Field": (200, 200, 200),
-    "Mesh": (160, 220, 220),
-    "TileSet": (180, 140, 240),
-    "Tiling": (140, 120, 220),
-}
-
-STATUS_PENS = {
-    "failed": ((230, 40, 40), 3.5),
-    "blocked": ((230, 150, 40), 2.5),
-    "cancelled": ((150, 150, 150), 2.5),
-}
-
-
-class StatusNodeItem(NodeItem):
-    """A node item that outlines itself by evaluation status (red = failed)."""
-
-    def __init__(self, name="node", parent=None):
-        super().__init__(name, parent)
-        self.status = ""
-        self._proxy_mode_threshold = 36  # keep titles readable when zoomed out to fit a graph
-
-    def paint(self, painter, option, widget):
-        super().paint(painter, option, widget)
-        pen_spec = STATUS_PENS.get(self.status)
-        if pen_spec is None:
-            return
-        colour, width = pen_spec
-        painter.save()
-        pen = QtGui.QPen(QtGui.QColor(*colour), width)
-        painter.setPen(pen)
-        painter.setBrush(QtCore.Qt.BrushStyle.NoBrush)
-        r = self.boundingRect().adjusted(1.0, 1.0, -1.0, -1.0)
-        painter.drawRoundedRect(r, 5.0, 5.0)
-        painter.restore()
-
-
-class EngineNode(BaseNode):
-    """Base of the generated NodeGraphQt classes; ENGINE_TYPE names the engine node type."""
-
-    __identifier__ = "mesoforge"
-    NODE_NAME = "Node"
-    ENGINE_TYPE = ""
-
-    def __init__(self):
-        super().__init__(qgraphics_item=StatusNodeItem)
-        cls = all_node_types()[self.ENGINE_TYPE]
-        for port in cls.inputs:
-            self.add_input(port.name, multi_input=port.multi, color=PORT_COLOURS.get(port.type))
-        for port in cls.outputs:
-            self.add_output(port.name, multi_output=True, color=PORT_COLOURS.get(port.type))
-        r, g, b = FAMILY_COLOURS.get(cls.family, (120, 120, 120))
-        self.set_color(r, g, b)
-
-
-def family_shade(family: str, factor: float) -> tuple[int, int, int]:
-    r, g, b = FAMILY_COLOURS.get(family, (120, 120, 120))
-    return (int(r * factor), int(g * factor), int(b * factor))
-
-
-def make_node_classes() -> dict[str, type[EngineNode]]:
-    """One NodeGraphQt class per engine node type, keyed by engine type name."""
-    classes = {}
-    for type_name, cls in sorted(all_node_types().items()):
-        classes[type_name] = type(
-            f"{type_name}Node", (EngineNode,),
-            {"__identifier__": f"mesoforge.{cls.family}", "NODE_NAME": cls.title or type_name,
-             "ENGINE_TYPE": type_name})
-    return classes
-
-
-class _DocumentNodeGraph(NodeGraph):
-    """NodeGraph whose gesture handlers hand over to the editor instead of
-    editing NodeGraphQt's own model."""
-
-    def __init__(self, editor: "NodeEditor", **kwargs):
-        self._editor = editor
-        super().__init__(**kwargs)
-
-    def _on_connection_changed(self, disconnected, connected):
-        self._editor.gesture_connections(disconnected, connected)
-
-    def _on_connection_sliced(self, ports):
-        self._editor.gesture_connections(ports, [])
-
-    def _on_nodes_moved(self, node_data):
-        self._editor.gesture_moved(node_data)
-
-    def _on_search_triggered(self, node_type, pos):
-        self._editor.gesture_create(node_type, pos)
-
-    def _on_insert_node(self, pipe, node_id, prev_node_pos):
-        # Dropping a node onto a pipe is only a move here.
-        self._editor.gesture_moved(prev_node_pos)
-
-    def _on_node_name_changed(self, node_id, name):
-        self._editor.gesture_rename(node_id, name)
-
-    def _on_node_data_dropped(self, mimedata, pos):
-        pass  # NodeGraphQt would import its own session files
-
-    def _on_context_menu_prompt(self, menu_name, node_id):
-        self._editor.menu_scene_pos = self.cursor_pos()
-        super()._on_context_menu_prompt(menu_name, node_id)
-
-    def delete_nodes(self, nodes, push_undo=True):
-        self._editor.gesture_delete([n.id for n in nodes])
-
-    def delete_node(self, node, push_undo=True):
-        self._editor.gesture_delete([node.id])
-
 
 class NodeEditor(QtWidgets.QWidget):
     """Node editor widget over a document and its undo stack.
@@ -170,7 +54,7 @@ class NodeEditor(QtWidgets.QWidget):
         self._statuses: dict[str, Any] = {}
         self._selected: str | None = None
 
-        self.graph = _DocumentNodeGraph(self)
+        self.graph = DocumentNodeGraph(self)
         self.graph.set_background_color(34, 36, 40)
         self.graph.set_grid_color(48, 51, 56)
         self.graph.set_acyclic(True)
@@ -420,27 +304,12 @@ class NodeEditor(QtWidgets.QWidget):
                       columns: int | None = None) -> bool:
         """Lay the graph out in columns by depth, wrapping into bands that fit the
         editor's width; one undoable "arrange nodes" step.  False if nothing moved."""
-        try:
-            order = self.doc.topological_order()
-        except GraphError:
-            return False
-        depth: dict[str, int] = {}
-        for nid in order:
-            depth[nid] = max((depth[e.src] + 1 for e in self.doc.inputs_of(nid) if e.src in depth), default=0)
         if columns is None:
             width = self.graph.viewer().viewport().width() / 0.8
             columns = max(2, int(width // column_width))
-        levels: dict[int, list[str]] = {}
-        for nid in order:
-            levels.setdefault(depth[nid], []).append(nid)
-        positions, top = {}, 0.0
-        n_levels = max(levels, default=-1) + 1
-        for band_start in range(0, n_levels, columns):
-            band = [levels.get(d, []) for d in range(band_start, min(band_start + columns, n_levels))]
-            for k, ids in enumerate(band):
-                for r, nid in enumerate(ids):
-                    positions[nid] = (k * column_width, top + r * row_height)
-            top += max(len(ids) for ids in band) * row_height + 0.6 * row_height
+        positions = arrange_positions(self.doc, columns=columns, column_width=column_width, row_height=row_height)
+        if positions is None:
+            return False
         moves = [MoveNode(nid, pos) for nid, pos in positions.items()
                  if tuple(self.doc.nodes[nid].position) != pos]
         if not moves:

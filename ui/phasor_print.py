@@ -1,8 +1,8 @@
 """The print part of the Phasor Infill dock: export G-code, preview it.
 
 "Export G-code…" slices the evaluated infill layer by layer and writes the
-file (``engine.phasor.infill.write_print`` through ``engine.fab``) in a
-`TaskThread`, with progress and Cancel (a cancelled export leaves no file).
+file (``PhasorInfillSession.write_print``, through ``engine.fab``) in a
+`TaskRunner`, with progress and Cancel (a cancelled export leaves no file).
 "Preview G-code…" reads a file back (``engine.phasor.preview.gcode_preview``,
 the last written one after an export) and emits its toolpaths as coloured
 line segments for the 3D viewport; one layer at a time is drawn here too.
@@ -10,7 +10,7 @@ line segments for the 3D viewport; one layer at a time is drawn here too.
 Printability (paper 5.1, ``engine.fab.printability``): after an export the
 written file's paths are emulated, and "Printability…" emulates a print of
 the current infill (the previewed G-code when there is no infill), in a
-`TaskThread`; `PrintabilityView` shows the overhang and overlap segments as
+second `TaskRunner`; `PrintabilityView` shows the overhang and overlap segments as
 two histograms by length (matplotlib) with their totals.
 """
 
@@ -21,7 +21,9 @@ import os
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from .phasor_worker import TaskThread
+from engine.nodes.phasor_session import PhasorInfillSession
+
+from .task_runner import TaskRunner
 
 ERROR_STYLE = "<span style='color:#c0392b'>{}</span>"
 PROGRESS_DELAY_MS = 300     # a progress bar only for what takes longer
@@ -152,8 +154,17 @@ class PrintBox(QtWidgets.QGroupBox):
         self.last_gcode: str | None = None
         self.previewed: str | None = None      # the G-code file whose layers are shown
         self.layers: list = []
-        self._task: TaskThread | None = None
-        self._check: TaskThread | None = None
+        self._export = TaskRunner(self)
+        self._export.progress.connect(lambda _t, done, total: self.progress.emit(int(done), int(total)))
+        self._export.finished.connect(lambda task, summary: self._on_done(task.data, summary))
+        self._export.failed.connect(lambda _t, msg: self._end(ERROR_STYLE.format(f"export failed: {msg}")))
+        self._export.cancelled.connect(lambda _t: self._end("export cancelled; no file written"))
+        self._checker = TaskRunner(self)
+        self._checker.progress.connect(lambda _t, done, total: self._on_check_progress(int(done), int(total)))
+        self._checker.finished.connect(lambda task, report: self._on_checked(report, task.data))
+        self._checker.failed.connect(
+            lambda _t, msg: self._end_check(ERROR_STYLE.format(f"printability failed: {msg}")))
+        self._checker.cancelled.connect(lambda _t: self._end_check("printability check cancelled"))
         self._settings = None          # of the last export; the printability check uses them too
         self._pixel = None
         self.printability_view: PrintabilityView | None = None
@@ -197,16 +208,19 @@ class PrintBox(QtWidgets.QGroupBox):
     def set_infill(self, infill, name: str | None, engine: str = "gpu") -> None:
         """The evaluated infill to export (None: export is off)."""
         self.infill, self.name, self.engine = infill, name or "phasor", engine
-        self.export_button.setEnabled(infill is not None and self._task is None)
+        self.export_button.setEnabled(infill is not None and not self.exporting)
         self.export_button.setToolTip("" if infill is not None else "needs an evaluated Phasor Noise")
         self._update_check_button()
 
     def _update_check_button(self) -> None:
-        self.check_button.setEnabled(self._check is None and (self.infill is not None or bool(self.layers)))
+        self.check_button.setEnabled(not self.checking and (self.infill is not None or bool(self.layers)))
 
     @property
     def exporting(self) -> bool:
-        return self._task is not None
+        return self._export.is_busy
+
+    def _session(self) -> PhasorInfillSession:
+        return PhasorInfillSession.of_infill(self.infill)
 
     def _dialog_open(self, caption: str, start: str):
         path, _ = QtWidgets.QFileDialog.getOpenFileName(self, caption, start,
@@ -249,7 +263,7 @@ class PrintBox(QtWidgets.QGroupBox):
 
     # -- export -----------------------------------------------------------------------------------
     def _on_export_clicked(self) -> None:
-        if self._task is not None or self.infill is None:
+        if self.exporting or self.infill is None:
             return
         start = self.last_gcode or os.path.join(os.getcwd(), f"{self.name}.gcode")
         path = self.ask_save_path("Export G-code", start)
@@ -259,38 +273,25 @@ class PrintBox(QtWidgets.QGroupBox):
     def export_gcode(self, path, *, settings=None, pixel=None) -> None:
         """Write the G-code of the infill in a thread; the preview follows when it is written.
 
-        ``pixel`` (mm) defaults to 0.1, finer when the highest F needs it.
+        ``pixel`` (mm) defaults to 0.1, finer when the highest F needs it
+        (``PhasorInfillSession.export_pixel``).
         """
-        from engine.phasor.infill import MIN_PIXELS_PER_PERIOD, write_print
-
-        infill, engine = self.infill, self.engine
-        if infill is None or self._task is not None:
+        if self.infill is None or self.exporting:
             return
-        if pixel is None:
-            pixel = min(0.1, 1.0 / (MIN_PIXELS_PER_PERIOD * infill.fields.max_frequency()))
+        session, engine = self._session(), self.engine
+        pixel = session.export_pixel() if pixel is None else pixel
         self._settings, self._pixel = settings, pixel
-        task = TaskThread(lambda progress: write_print(infill, path, settings=settings, pixel=pixel,
-                                                       engine=engine, progress=progress), self)
-        task.progress.connect(self.progress)
-        task.done.connect(lambda summary: self._on_done(path, summary))
-        task.failed.connect(lambda msg: self._end(ERROR_STYLE.format(f"export failed: {msg}")))
-        task.cancelled.connect(lambda: self._end("export cancelled; no file written"))
-        task.finished.connect(task.deleteLater)
-        self._task = task
         self.export_button.setEnabled(False)
         self.message.emit(f"exporting {os.path.basename(str(path))}…")
         self.running.emit(True)
-        task.start()
+        self._export.submit(lambda task: session.write_print(path, settings=settings, pixel=pixel, engine=engine,
+                                                             progress=task.progress), data=path)
 
     def cancel(self) -> None:
-        for task in (self._task, self._check):
-            if task is not None:
-                task.cancel()
+        self._export.cancel()
+        self._checker.cancel()
 
     def _end(self, text: str) -> None:
-        task, self._task = self._task, None
-        if task is not None:
-            task.wait()
         self.export_button.setEnabled(self.infill is not None)
         self.running.emit(False)
         self.message.emit(text)
@@ -305,7 +306,7 @@ class PrintBox(QtWidgets.QGroupBox):
     # -- printability -----------------------------------------------------------------------------
     @property
     def checking(self) -> bool:
-        return self._check is not None
+        return self._checker.is_busy
 
     def _on_check_clicked(self) -> None:
         if self.infill is not None:
@@ -322,44 +323,32 @@ class PrintBox(QtWidgets.QGroupBox):
         """
         from engine.fab import PrintSettings, printability
 
-        if self._check is not None:
+        if self.checking:
             return
         settings = self._settings or PrintSettings()
         nozzle = settings.nozzle_diameter
         if layers is None:
             if self.infill is None:
                 return
-            from engine.phasor.infill import infill_toolpaths
-            from engine.phasor.infill import MIN_PIXELS_PER_PERIOD
-
-            infill, engine = self.infill, self.engine
-            pixel = self._pixel or min(0.1, 1.0 / (MIN_PIXELS_PER_PERIOD * infill.fields.max_frequency()))
+            session, engine, pixel = self._session(), self.engine, self._pixel
             source = source or f"{self.name} ({settings.layer_height:g} mm layers)"
 
-            def work(progress):
-                paths = infill_toolpaths(infill, settings, pixel=pixel, engine=engine, progress=progress)
-                return printability(paths, nozzle_diameter=nozzle, progress=progress)
+            def work(task):
+                return session.printability(settings, pixel=pixel, engine=engine, progress=task.progress)
         else:
             layers = list(layers)
             source = source or "the G-code"
 
-            def work(progress):
-                return printability(layers, nozzle_diameter=nozzle, progress=progress)
-        task = TaskThread(work, self)
-        task.progress.connect(self._on_check_progress)
-        task.done.connect(lambda report: self._on_checked(report, source))
-        task.failed.connect(lambda msg: self._end_check(ERROR_STYLE.format(f"printability failed: {msg}")))
-        task.cancelled.connect(lambda: self._end_check("printability check cancelled"))
-        task.finished.connect(task.deleteLater)
-        self._check = task
+            def work(task):
+                return printability(layers, nozzle_diameter=nozzle, progress=task.progress)
+        self._checker.submit(work, data=source)
         self._update_check_button()
         self.check_progress.setRange(0, 0)
         QtCore.QTimer.singleShot(PROGRESS_DELAY_MS, self, self._show_check_progress)
         self.message.emit(f"emulating the print of {source}…")
-        task.start()
 
     def _show_check_progress(self) -> None:
-        if self._check is not None:
+        if self.checking:
             self.check_row.show()
 
     def _on_check_progress(self, done: int, total: int) -> None:
@@ -368,13 +357,9 @@ class PrintBox(QtWidgets.QGroupBox):
             self.check_progress.setValue(min(done, total))
 
     def cancel_check(self) -> None:
-        if self._check is not None:
-            self._check.cancel()
+        self._checker.cancel()
 
     def _end_check(self, text: str) -> None:
-        task, self._check = self._check, None
-        if task is not None:
-            task.wait()
         self.check_row.hide()
         self._update_check_button()
         self.message.emit(text)
@@ -390,9 +375,5 @@ class PrintBox(QtWidgets.QGroupBox):
         self.printability.emit(report)
 
     def shutdown(self, timeout_ms: int = 10000) -> None:
-        for name in ("_task", "_check"):
-            task = getattr(self, name)
-            setattr(self, name, None)
-            if task is not None:
-                task.cancel()
-                task.wait(timeout_ms)
+        self._export.shutdown(timeout_ms)
+        self._checker.shutdown(timeout_ms)

@@ -17,7 +17,7 @@ import math
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from engine.graph.values import Stiffness
+from engine.physics.values import Stiffness
 from engine.physics.elastic import compliance
 
 VOIGT_LABELS = ("xx", "yy", "zz", "yz", "xz", "xy")

@@ -24,40 +24,21 @@ from pathlib import Path
 
 from PySide6 import QtCore, QtWidgets
 
-from app.growth_cmd import parse_progress_line, study_argv, study_process
+from engine.batch.study_process import parse_progress_line, study_argv, study_process
 from engine.batch.study_summary import load_study
-from engine.growth import list_tilesets, load_tileset
+from engine.growth import load_tileset
 
+from . import study_dialogs
+from .study_dialogs import _row, _spin, hint_groups_from_text, shipped_tilesets
 from .study_plots import StudyPlots
 
 ROOT = Path(__file__).resolve().parent.parent
-DATABASE_FILTER = "Study database (*.csv *.parquet);;All files (*)"
 RELOAD_MS = 1000         # least time between re-reads of the database while rows arrive
 STOP_GRACE_MS = 8000     # after Cancel, kill the process if it has not stopped by then
 STDERR_TAIL = 40         # lines of the process's stderr kept for error messages
 EXIT_STOPPED = 130       # `mesoforge study` stopped by a signal, whole rows kept
 DEFAULT_TILESET = "TL+-"
 PROGRESS_FORMAT = "%v / %m samples"
-
-
-def shipped_tilesets() -> list:
-    """Tile set names from resources/tilesets, one per file (not its file-stem alias)."""
-    seen, names = set(), []
-    for name, path in list_tilesets().items():
-        if path not in seen:
-            seen.add(path)
-            names.append(name)
-    return names
-
-
-def hint_groups_from_text(text: str) -> list:
-    """One hint text per non-empty line; a line ``uniform`` is the uniform group (``""``)."""
-    out = []
-    for line in text.splitlines():
-        line = line.strip()
-        if line:
-            out.append("" if line.lower() == "uniform" else line)
-    return out
 
 
 class StudyPanel(QtWidgets.QWidget):
@@ -451,42 +432,13 @@ class StudyPanel(QtWidgets.QWidget):
         self.error_log.setPlainText(details)
         self.error_log.setVisible(bool(details))
 
-    # ------------------------------------------------------------ dialogs
+    # ------------------------------------------------------------ dialogs (replaceable by tests)
 
     def _dialog_open_path(self) -> str | None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(self, "Open study database", "",
-                                                        DATABASE_FILTER)
-        return path or None
+        return study_dialogs.open_path(self)
 
     def _dialog_save_path(self) -> str | None:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(self, "Study database", "study.csv",
-                                                        DATABASE_FILTER)
-        if path and not Path(path).suffix:
-            path += ".csv"
-        return path or None
+        return study_dialogs.save_path(self)
 
     def _dialog_confirm_replace(self, path: Path) -> bool:
-        buttons = QtWidgets.QMessageBox.StandardButton
-        answer = QtWidgets.QMessageBox.question(
-            self, "Replace the database?",
-            f"{path.name} already exists. Run starts it afresh and its rows are lost; "
-            f"Resume continues it instead.\n\nReplace it?",
-            buttons.Yes | buttons.No, buttons.No)
-        return answer == buttons.Yes
-
-
-def _spin(lo: int, hi: int, value: int, tip: str) -> QtWidgets.QSpinBox:
-    s = QtWidgets.QSpinBox()
-    s.setRange(lo, hi)
-    s.setValue(value)
-    s.setToolTip(tip)
-    return s
-
-
-def _row(*widgets) -> QtWidgets.QWidget:
-    w = QtWidgets.QWidget()
-    lay = QtWidgets.QHBoxLayout(w)
-    lay.setContentsMargins(0, 0, 0, 0)
-    for x in widgets:
-        lay.addWidget(x)
-    return w
+        return study_dialogs.confirm_replace(self, path)

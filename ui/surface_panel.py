@@ -31,10 +31,13 @@ from PySide6 import QtCore, QtWidgets
 
 from engine.graph import GraphError, all_node_types
 from engine.graph.errors import NodeInputError
-from engine.graph.values import SurfaceReport
+from engine.graph.query import nearest_upstream, of_types, type_of
+from engine.geometry.surfaces.values import SurfaceReport
 from engine.nodes.surfaces import boundary_schematic
 
-from .inspector import EDITORS, STATUS_COLOURS, MergingParamPush
+from .colours import STATUS_COLOURS
+from .inspector import EDITORS
+from .param_push import MergingParamPush
 from .surface_plots import ConvergenceChart, LoopSchematic
 
 SURFACE_NODE_TYPES = ("Surface", "DualSurface", "AssociateFamily")
@@ -70,17 +73,11 @@ def surface_nodes(doc) -> list[str]:
 
 
 def source_surface(doc, node_id: str | None) -> str | None:
-    """The Surface node ``node_id`` is, or the nearest one upstream of it."""
-    seen, todo = set(), [node_id] if node_id in doc.nodes else []
-    while todo:
-        nid = todo.pop(0)
-        if nid in seen:
-            continue
-        seen.add(nid)
-        if doc.nodes[nid].type_name == "Surface":
-            return nid
-        todo += [e.src for e in doc.inputs_of(nid)]
-    return None
+    """The Surface node ``node_id`` is, or the nearest one upstream of it
+    (``engine.graph.query``; no fallback: a node with no Surface above has none)."""
+    if type_of(doc, node_id) == "Surface":
+        return node_id
+    return nearest_upstream(doc, node_id, of_types(doc, ("Surface",))) if node_id else None
 
 
 def input_chains(doc, outputs: dict, surface_id: str):

@@ -19,17 +19,16 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from engine.graph import GraphDocument, Macro, SetParam, UndoStack
 from engine.growth.tileset_edit import (TileSetDraft, TileSetEditError, add_block, add_rule,
-                                        block_adjacency, browse_tilesets, describe_rule,
-                                        explain_adjacency, move_rule, remove_block, remove_rule,
+                                        describe_rule, move_rule, remove_block, remove_rule,
                                         rename_block, rules_referencing, save_path_for, set_name,
                                         set_weight, user_tileset_dir)
 
+from .tileset_adjacency import AdjacencyView
+from .tileset_browser import PATH_ROLE, TileSetBrowser
 from .tileset_widgets import (ICON_PX, AddBlockDialog, _button, _error_label, _set_items,
                               _weight_box, block_pixmap)
 
-PATH_ROLE = QtCore.Qt.ItemDataRole.UserRole
 ANY_FACE = "any face"
-CELL_COLOURS = {"all": "#cfe8c8", "some": "#f3e1b0", "none": "#f0c4c4"}
 
 
 class TileSetEditor(QtWidgets.QWidget):
@@ -67,9 +66,7 @@ class TileSetEditor(QtWidgets.QWidget):
         split = QtWidgets.QSplitter(QtCore.Qt.Orientation.Vertical)
         outer.addWidget(split, 1)
 
-        self.browser = QtWidgets.QTreeWidget()
-        self.browser.setHeaderLabels(["Tile set", "dim", "blocks"])
-        self.browser.setRootIsDecorated(True)
+        self.browser = TileSetBrowser()
         self.browser.currentItemChanged.connect(self._on_browse)
         split.addWidget(self.browser)
 
@@ -81,7 +78,10 @@ class TileSetEditor(QtWidgets.QWidget):
         lay.addWidget(self.status_label)
         self.tabs = QtWidgets.QTabWidget()
         self.tabs.addTab(self._build_blocks(), "Blocks")
-        self.tabs.addTab(self._build_adjacency(), "Adjacency")
+        self.adjacency = AdjacencyView()
+        self.face_box, self.matrix, self.pair_list = (self.adjacency.face_box, self.adjacency.matrix,
+                                                      self.adjacency.pair_list)
+        self.tabs.addTab(self.adjacency, "Adjacency")
         self.tabs.addTab(self._build_rules(), "Rules")
         lay.addWidget(self.tabs, 1)
         split.addWidget(body)
@@ -119,25 +119,6 @@ class TileSetEditor(QtWidgets.QWidget):
         self.remove_button = _button("Remove", self.remove_selected_block, row)
         self.add_block_button = _button("Add block…", self.open_add_block_dialog, row)
         lay.addLayout(row)
-        return w
-
-    def _build_adjacency(self) -> QtWidgets.QWidget:
-        w = QtWidgets.QWidget()
-        lay = QtWidgets.QVBoxLayout(w)
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(QtWidgets.QLabel("Column block across face"))
-        self.face_box = QtWidgets.QComboBox()
-        self.face_box.currentIndexChanged.connect(lambda *_: self._show_adjacency())
-        row.addWidget(self.face_box)
-        row.addWidget(QtWidgets.QLabel("of row block: allowed / orientation pairs"))
-        row.addStretch(1)
-        lay.addLayout(row)
-        self.matrix = QtWidgets.QTableWidget()
-        self.matrix.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
-        self.matrix.currentCellChanged.connect(lambda *_: self._show_pairs())
-        lay.addWidget(self.matrix, 2)
-        self.pair_list = QtWidgets.QListWidget()
-        lay.addWidget(self.pair_list, 1)
         return w
 
     def _build_rules(self) -> QtWidgets.QWidget:
@@ -192,31 +173,12 @@ class TileSetEditor(QtWidgets.QWidget):
         return self.user_folder if self.user_folder is not None else user_tileset_dir()
 
     def refresh_browser(self) -> None:
-        current = self.draft.source if self.draft is not None else None
-        self.browser.blockSignals(True)
-        self.browser.clear()
-        groups = {True: QtWidgets.QTreeWidgetItem(["Shipped"]),
-                  False: QtWidgets.QTreeWidgetItem([f"User ({self._folder()})"])}
-        self.browser.addTopLevelItems(list(groups.values()))
-        for entry in browse_tilesets(self._folder()):
-            item = QtWidgets.QTreeWidgetItem(
-                [entry.name, str(entry.dim or "?"), str(entry.n_blocks or "?")])
-            item.setData(0, PATH_ROLE, str(entry.path))
-            item.setToolTip(0, entry.error or str(entry.path))
-            if entry.error:
-                item.setForeground(0, QtGui.QBrush(QtGui.QColor("#c03030")))
-            groups[entry.shipped].addChild(item)
-            if current is not None and Path(entry.path) == Path(current):
-                self.browser.setCurrentItem(item)
-        self.browser.expandAll()
-        self.browser.resizeColumnToContents(0)
-        self.browser.blockSignals(False)
+        """Read the shipped and user folders again (keeps the open set selected)."""
+        self.browser.refresh(self._folder(), self.draft.source if self.draft is not None else None)
 
     def browser_item(self, name: str) -> QtWidgets.QTreeWidgetItem | None:
         """The browser row of the set called ``name`` (shipped first)."""
-        flags = QtCore.Qt.MatchFlag.MatchExactly | QtCore.Qt.MatchFlag.MatchRecursive
-        rows = [i for i in self.browser.findItems(name, flags, 0) if i.data(0, PATH_ROLE)]
-        return rows[0] if rows else None
+        return self.browser.item_named(name)
 
     def _on_browse(self, item, previous) -> None:
         path = item.data(0, PATH_ROLE) if item is not None else None
@@ -435,7 +397,7 @@ class TileSetEditor(QtWidgets.QWidget):
             w.setEnabled(ts is not None)
         self._show_blocks(ts)
         self._show_rules(ts)
-        self._show_adjacency()
+        self.adjacency.set_tileset(ts)
         self._update_use_button()
 
     def _show_blocks(self, ts) -> None:
@@ -484,47 +446,3 @@ class TileSetEditor(QtWidgets.QWidget):
             _set_items(box, names)
         faces = list(ts.faces) if ts is not None else []
         _set_items(self.rule_face, [ANY_FACE] + faces)
-        _set_items(self.face_box, faces)
-
-    def _show_adjacency(self) -> None:
-        ts = self._ts
-        face = self.face_box.currentText()
-        if ts is None or not face:
-            self.matrix.setRowCount(0)
-            self.matrix.setColumnCount(0)
-            self.pair_list.clear()
-            return
-        allowed, total = block_adjacency(ts, face)
-        names = list(ts.block_names)
-        self.matrix.blockSignals(True)
-        self.matrix.setRowCount(len(names))
-        self.matrix.setColumnCount(len(names))
-        self.matrix.setVerticalHeaderLabels(names)
-        self.matrix.setHorizontalHeaderLabels(names)
-        for i in range(len(names)):
-            for j in range(len(names)):
-                k, n = int(allowed[i, j]), int(total[i, j])
-                cell = QtWidgets.QTableWidgetItem(f"{k}/{n}")
-                cell.setTextAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
-                level = "all" if k == n else ("none" if k == 0 else "some")
-                cell.setBackground(QtGui.QColor(CELL_COLOURS[level]))
-                cell.setToolTip(f"{names[j]} across {face} of {names[i]}: {k} of {n} "
-                                f"orientation pairs allowed")
-                self.matrix.setItem(i, j, cell)
-        self.matrix.resizeColumnsToContents()
-        self.matrix.blockSignals(False)
-        self._show_pairs()
-
-    def _show_pairs(self) -> None:
-        self.pair_list.clear()
-        ts = self._ts
-        i, j = self.matrix.currentRow(), self.matrix.currentColumn()
-        if ts is None or i < 0 or j < 0 or not self.face_box.currentText():
-            self.pair_list.addItem("Click a cell to see each orientation pair and why.")
-            return
-        for v in explain_adjacency(ts, ts.block_names[i], ts.block_names[j],
-                                   self.face_box.currentText()):
-            item = QtWidgets.QListWidgetItem(f"{v.b} across {v.face} of {v.a}: {v.reason}")
-            item.setToolTip(item.text())
-            item.setForeground(QtGui.QBrush(QtGui.QColor("#2a7a2a" if v.allowed else "#b03030")))
-            self.pair_list.addItem(item)

@@ -18,7 +18,9 @@ from PySide6 import QtWidgets
 
 from engine.fab import vtk_line_cells
 from engine.graph import GraphDocument
-from engine.graph.values import Skeleton, Solid, Stiffness, VoxelModel
+from engine.graph.query import nearest_upstream, pick_node, type_of
+from engine.geometry.values import Skeleton, Solid, VoxelModel
+from engine.physics.values import Stiffness
 from engine.physics.material_sphere import material_polar, material_sphere_polydata
 
 SOLID_COLOUR = "#d8cfc0"
@@ -52,21 +54,9 @@ def skeleton_of(outputs: dict) -> Skeleton | None:
     return None
 
 
-def _upstream_with(doc: GraphDocument, start: str, outputs: dict, test) -> str | None:
-    """Nearest node above `start` (breadth first, inputs in connection order) whose outputs pass `test`."""
-    seen, frontier = {start}, [start]
-    while frontier:
-        nxt = []
-        for nid in frontier:
-            for e in doc.inputs_of(nid):
-                if e.src in seen:
-                    continue
-                seen.add(e.src)
-                if e.src in outputs and test(outputs[e.src]) is not None:
-                    return e.src
-                nxt.append(e.src)
-        frontier = nxt
-    return None
+def _has(outputs: dict, value_of):
+    """An ``accept`` predicate for ``engine.graph.query``: the node's outputs hold a value ``value_of`` finds."""
+    return lambda nid: nid in outputs and value_of(outputs[nid]) is not None
 
 
 def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None = None
@@ -74,35 +64,27 @@ def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None =
     """(solid node id, skeleton node id) to display.
 
     The selected node's solid if it has one; otherwise the solid feeding the
-    Voxel node, else the last solid in topological order.  The skeleton is
-    the selected node's if it is a skeleton node, else the nearest skeleton
-    above the shown solid.
+    Voxel node, else the last solid in topological order (a Voxel node's
+    solid is only shown when it is selected).  The skeleton is the selected
+    node's if it is a skeleton node, else the nearest skeleton above the
+    shown solid.  Plain calls of ``engine.graph.query``.
     """
     outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
+    has_solid, has_skeleton = _has(outputs, solid_of), _has(outputs, skeleton_of)
     solid_id = skel_id = None
-    if selected in outputs:
-        if solid_of(outputs[selected]) is not None:
-            solid_id = selected
-        elif skeleton_of(outputs[selected]) is not None:
-            skel_id = selected
+    if selected is not None and has_solid(selected):
+        solid_id = selected
+    elif selected is not None and has_skeleton(selected):
+        skel_id = selected
     if solid_id is None:
-        for nid, inst in doc.nodes.items():
-            if inst.type_name == "Voxel":
-                feeders = [e.src for e in doc.inputs_of(nid) if e.src in outputs]
-                if feeders and solid_of(outputs[feeders[0]]) is not None:
-                    solid_id = feeders[0]
-                    break
-    if solid_id is None:
-        try:
-            order = doc.topological_order()
-        except Exception:
-            order = list(doc.nodes)
-        for nid in reversed(order):
-            if nid in outputs and doc.nodes[nid].type_name != "Voxel" and solid_of(outputs[nid]) is not None:
-                solid_id = nid
-                break
+        voxel = next((nid for nid, node in doc.nodes.items() if node.type_name == "Voxel"), None)
+        feeder = nearest_upstream(doc, voxel, lambda _nid: True) if voxel is not None else None
+        if feeder is not None and has_solid(feeder):
+            solid_id = feeder
+        else:
+            solid_id = pick_node(doc, None, lambda nid: has_solid(nid) and type_of(doc, nid) != "Voxel")
     if skel_id is None and solid_id is not None:
-        skel_id = _upstream_with(doc, solid_id, outputs, skeleton_of)
+        skel_id = nearest_upstream(doc, solid_id, has_skeleton)
     return solid_id, skel_id
 
 
@@ -126,19 +108,11 @@ def material_polar_polydata(C2d: np.ndarray, n: int = 360) -> pv.PolyData:
 
 
 def pick_stiffness_node(doc: GraphDocument, outputs: dict, selected: str | None = None) -> str | None:
-    """Node whose material sphere to draw: the selected node if it produced a
-    3D Stiffness, else the last such node in topological order (None if none did)."""
+    """Node whose material sphere to draw, by ``engine.graph.query.pick_node``:
+    the selected node if it produced a Stiffness, else the nearest such node
+    above it, else the last such node in topological order (None if none did)."""
     outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
-    if selected in outputs and stiffness_of(outputs[selected]) is not None:
-        return selected
-    try:
-        order = doc.topological_order()
-    except Exception:
-        order = list(doc.nodes)
-    for nid in reversed(order):
-        if nid in outputs and stiffness_of(outputs[nid]) is not None:
-            return nid
-    return None
+    return pick_node(doc, selected, _has(outputs, stiffness_of))
 
 
 # -- geometry helpers ------------------------------------------------------------------

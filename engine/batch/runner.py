@@ -24,7 +24,7 @@ import time
 import uuid
 from typing import Callable, Iterable
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 
 __all__ = ["run_samples", "SYNCHRONOUS"]
 
@@ -36,7 +36,7 @@ def _keep_going(progress, done: int, total: int) -> bool:
     if progress is None:
         return True
     answer = progress(int(done), int(total))
-    # None (a callback that returns nothing) means carry on, as in engine.geometry.cancel
+    # None (a callback that returns nothing) means carry on, as in engine.progress
     return answer is None or bool(answer)
 
 

@@ -1,10 +1,13 @@
 """One study sample: grow a tiling, homogenize it, make its row.
 
-``evaluate_sample`` is what the workers run. It depends only on its
-arguments (the study configuration and the sample's seed and hints) and
-solves with one numba thread and one BLAS thread, so a row is bit-for-bit
-the same whichever scheduler, worker or order produced it (on machines with
-the same numpy / scipy builds; the ``seconds`` cell excepted).
+``evaluate_sample`` is what the workers run: the sample's graph TileSet →
+Grow → TilingProperties (``engine.batch.sample_graph``, the Grow node's
+``seed`` parameter set to the sample's seed) evaluated by the Evaluator. It
+depends only on its arguments (the study configuration and the sample's
+seed and hints) and solves with one numba thread and one BLAS thread, so a
+row is bit-for-bit the same whichever scheduler, worker or order produced it
+(on machines with the same numpy / scipy builds; the ``seconds`` cell
+excepted).
 """
 
 from __future__ import annotations
@@ -17,12 +20,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.geometry.cancel import Cancelled
-from engine.growth import TileSet, grow_tiling, hint_table, realised_probabilities
-from engine.growth.properties import constant_names, constants_of, homogenize_tiling
+from engine.growth import TileSet, hint_table, realised_probabilities
+from engine.growth.properties import constant_names, constants_of
+from engine.progress import Cancelled
 
-from .blas_threads import blas_threads
 from .hints_text import format_hints
+from .sample_graph import GraphSampleError, evaluate_study_graph, study_document
 
 __all__ = ["StudyConfig", "Sample", "sample_seed", "columns", "evaluate_sample",
            "block_hints", "STATUS_OK", "STATUS_SINGULAR", "STATUS_ERROR"]
@@ -122,6 +125,11 @@ def columns(config: StudyConfig) -> list:
             + ["E_s", "nu_s", "resolution", "member", "void", "iterations", "seconds", "config"])
 
 
+def _grown(row: dict, tiling, ts) -> None:
+    row["n_defects"] = tiling.n_defects
+    row.update({f"p_{b}": float(p) for b, p in zip(ts.block_names, realised_probabilities(tiling, ts))})
+
+
 def evaluate_sample(config: StudyConfig, sample: Sample, progress=None) -> dict:
     """Grow and homogenize one sample; return its row (column -> value).
 
@@ -143,22 +151,20 @@ def evaluate_sample(config: StudyConfig, sample: Sample, progress=None) -> dict:
     row.update({c: math.nan for c in nan_cols})
     row.update({f"p_{b}": math.nan for b in ts.block_names})
     try:
-        tiling = grow_tiling(ts, config.shape, hints=sample.hints, periodic=config.periodic,
-                             availability=config.availability, rng=sample.seed)
-        row["n_defects"] = tiling.n_defects
-        row.update({f"p_{b}": float(p) for b, p in
-                    zip(ts.block_names, realised_probabilities(tiling, ts))})
-        with blas_threads(1):
-            res = homogenize_tiling(tiling, ts, E=config.E, nu=config.nu,
-                                    resolution=config.resolution, line_width=config.line_width,
-                                    radius=config.radius, void=config.void, tol=config.tol,
-                                    threads=1, progress=progress)
+        doc = study_document(config, sample.hints, sample.seed)
+        tv, res = evaluate_study_graph(doc, progress=progress)
     except Cancelled:
         raise
-    except Exception as exc:   # recorded in the row: one bad sample never stops a study
+    except GraphSampleError as exc:   # recorded in the row: one bad sample never stops a study
+        if exc.value is not None:      # grown, not homogenized
+            _grown(row, exc.value.tiling, ts)
+        row.update(status=STATUS_ERROR, error=str(exc), seconds=time.perf_counter() - t0)
+        return row
+    except Exception as exc:          # a value the nodes' schemas refuse
         row.update(status=STATUS_ERROR, error=f"{type(exc).__name__}: {exc}",
                    seconds=time.perf_counter() - t0)
         return row
+    _grown(row, tv.tiling, ts)
     C = np.asarray(res.C, dtype=np.float64)
     n = C.shape[0]
     row.update({f"C{i + 1}{j + 1}": float(C[i, j]) for i in range(n) for j in range(i, n)})

@@ -52,6 +52,7 @@ from engine.growth.properties import check_options
 
 from .rows import StudyFileError, read_rows
 from .runner import run_samples
+from .sample_graph import check_tileset
 from .sample import (STATUS_ERROR, STATUS_OK, STATUS_SINGULAR, Sample, StudyConfig, block_hints,
                      columns, evaluate_sample, sample_seed)
 from .study_file import check_parquet, parquet_metadata, plan_journal, read_params, study_params
@@ -107,6 +108,11 @@ def make_config(tileset, *, shape=(20, 20), periodic=True, availability=None, E=
     E = _check_real("E", E, 0.0, math.inf)
     nu = _check_real("nu", nu, -1.0, 0.5)
     tol = _check_real("tol", tol, 0.0, 1.0)
+    from engine.nodes.growth import PROPERTIES_TOL
+    if tol != PROPERTIES_TOL:     # samples are solved by the Tiling Properties node
+        raise ValueError(f"tol must be {PROPERTIES_TOL:g}, the solver tolerance of the Tiling "
+                         f"Properties node that homogenizes each sample; got {tol!r}")
+    check_tileset(ts)             # each sample's graph reads the set from its file
     resolution, line_width, radius = check_options(shp, resolution=resolution,
                                                    line_width=line_width, radius=radius,
                                                    void=void)

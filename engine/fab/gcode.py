@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.cancel import report
+from engine.progress import report
 from .print_settings import PrintSettings
 
 GENERATOR = "Mesoforge engine.fab"
@@ -220,7 +220,7 @@ def write_gcode(layers, path, *, settings=None, n_layers=None, progress=None) ->
         available, else the total reported is 0 ("unknown").
     progress : callable or None
         ``progress(done, total) -> bool`` after each layer; False cancels
-        (raises :class:`~engine.geometry.cancel.Cancelled`, file untouched).
+        (raises :class:`~engine.progress.Cancelled`, file untouched).
 
     Returns
     -------

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.cancel import report
+from engine.progress import report
 from ._raster import emulate_layer
 from .ordering import is_closed
 

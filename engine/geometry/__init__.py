@@ -6,7 +6,7 @@ that need them, so importing this package stays cheap.
 """
 
 from .box_cell import box_grid_shape, check_cell
-from .cancel import Cancelled
+from engine.progress import Cancelled
 from .csg import csg_difference, csg_intersection, csg_reduce, csg_union
 from .marching import (boundary_section_match, mesh_volume, mesh_volume_fraction,
                        periodic_mesh, solid_volume_fraction)

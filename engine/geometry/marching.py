@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .box_cell import check_cell
-from .cancel import report
+from engine.progress import report
 
 __all__ = ["periodic_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
            "mesh_volume_fraction", "mesh_volume"]

@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit, prange
 
 from .box_cell import check_cell, check_grid_shape, default_band
-from .cancel import run_chunked
+from engine.progress import run_chunked
 
 __all__ = ["line_sdf_grid", "line_sdf_reference", "METHODS"]
 

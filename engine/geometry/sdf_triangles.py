@@ -29,7 +29,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .cancel import run_chunked
+from engine.progress import run_chunked
 from .sdf_lines import check_band, grid_nodes, grid_of, index_ranges
 
 __all__ = ["surface_sdf_grid", "surface_sdf_reference", "boundary_flags"]

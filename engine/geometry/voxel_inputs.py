@@ -37,7 +37,7 @@ from numba import njit
 
 from engine.memory import MemoryLimitError, available_memory_bytes, memory_budget
 
-from .cancel import run_chunked
+from engine.progress import run_chunked
 
 __all__ = ["load_voxel_grid", "voxelize_mesh", "validate_density", "memory_estimate_bytes",
            "check_memory", "available_memory_bytes", "GridTooLarge", "INPUT_SUFFIXES", "grid_shape_of"]

@@ -5,7 +5,7 @@ from .commands import (AddNode, Command, Connect, Disconnect, Macro, MoveNode, R
 from .document import Edge, GraphDocument, GraphSnapshot, NodeInstance
 from .errors import GraphError, NodeInputError, ParamError, ProjectFileError
 from .evaluator import EvalReport, Evaluator, NodeResult
-from .node import (FAMILY_COLOURS, Cancelled, CancelToken, EvalContext, NodeType, all_node_types,
+from .node import (Cancelled, CancelToken, EvalContext, NodeType, all_node_types,
                    node_type, register)
 from .project import document_from_dict, document_to_dict, load_project, save_project, write_atomic
 from .schema import Param, Port
@@ -14,7 +14,7 @@ __all__ = [
     "AddNode", "Command", "Connect", "Disconnect", "Macro", "MoveNode", "RemoveNode", "SetLabel",
     "SetParam", "SetSeed", "UndoStack", "Edge", "GraphDocument", "GraphSnapshot", "NodeInstance",
     "GraphError", "NodeInputError", "ParamError", "ProjectFileError", "EvalReport", "Evaluator",
-    "NodeResult", "FAMILY_COLOURS", "Cancelled", "CancelToken", "EvalContext", "NodeType",
+    "NodeResult", "Cancelled", "CancelToken", "EvalContext", "NodeType",
     "all_node_types", "node_type", "register", "document_from_dict", "document_to_dict",
     "load_project", "save_project", "write_atomic", "Param", "Port",
 ]

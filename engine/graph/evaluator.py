@@ -25,7 +25,7 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-from .document import GraphDocument, GraphSnapshot, topological_order
+from .document import Edge, GraphDocument, GraphSnapshot, topological_order
 from .errors import GraphError
 from .node import Cancelled, CancelToken, EvalContext, node_seed, node_type
 from .node_state import StoredState, parse_state_entry
@@ -100,11 +100,25 @@ class _Held:
     blob: dict | None = None  # encode_state(outputs), made once when first exported
 
 
-def check_required_inputs(snapshot: GraphSnapshot, node_id: str) -> None:
+def incoming_edges(snapshot: GraphSnapshot) -> dict[str, dict[str, list[Edge]]]:
+    """``{node_id: {input port: [edges in connection order]}}`` of a snapshot,
+    made in one pass over its edges (nodes and ports without edges are absent)."""
+    index: dict[str, dict[str, list[Edge]]] = {}
+    for e in snapshot.edges:
+        index.setdefault(e.dst, {}).setdefault(e.dst_port, []).append(e)
+    return index
+
+
+def check_required_inputs(snapshot: GraphSnapshot, node_id: str,
+                          incoming: dict[str, dict[str, list[Edge]]] | None = None) -> None:
+    """GraphError naming the first required input port of ``node_id`` with no
+    edge; ``incoming`` (from `incoming_edges`) saves a scan of every edge."""
     type_name, _ = snapshot.nodes[node_id]
     cls = node_type(type_name)
+    ports = incoming.get(node_id, {}) if incoming is not None else None
     for port in cls.inputs:
-        if port.required and not snapshot.inputs_of(node_id, port.name):
+        connected = ports.get(port.name) if ports is not None else snapshot.inputs_of(node_id, port.name)
+        if port.required and not connected:
             raise GraphError(f"node {node_id!r} ({type_name}): required input {port.name!r} "
                              f"({port.type}) is not connected", node=node_id, where=port.name)
 
@@ -223,7 +237,8 @@ class Evaluator:
         with self._lock:
             return self._evaluate(snap, targets, cancel, on_progress, on_node_done)
 
-    def _needed(self, snap: GraphSnapshot, targets: list[str] | None) -> list[str]:
+    def _needed(self, snap: GraphSnapshot, targets: list[str] | None,
+                incoming: dict[str, dict[str, list[Edge]]]) -> list[str]:
         order = list(snap.order) or topological_order(list(snap.nodes), snap.edges)
         if targets is None:
             return order
@@ -236,7 +251,7 @@ class Evaluator:
             if n not in snap.nodes:
                 raise GraphError(f"no node with id {n!r}", node=n)
             need.add(n)
-            stack.extend(e.src for e in snap.edges if e.dst == n)
+            stack.extend(e.src for es in incoming.get(n, {}).values() for e in es)
         return [n for n in order if n in need]
 
     def _evaluate(self, snap, targets, cancel, on_progress, on_node_done) -> EvalReport:
@@ -244,8 +259,9 @@ class Evaluator:
         self._apply_pending()
         report = EvalReport()
         keys: dict[str, str] = {}
-        for nid in self._needed(snap, targets):
-            result = self._run_node(snap, nid, keys, report, cancel, on_progress)
+        incoming = incoming_edges(snap)  # once per evaluation, not one scan of every edge per node
+        for nid in self._needed(snap, targets, incoming):
+            result = self._run_node(snap, nid, keys, report, cancel, on_progress, incoming)
             report.results[nid] = result
             if on_node_done is not None:
                 on_node_done(result)
@@ -255,20 +271,21 @@ class Evaluator:
         report.seconds = time.perf_counter() - t_start
         return report
 
-    def _run_node(self, snap, nid, keys, report, cancel, on_progress) -> NodeResult:
+    def _run_node(self, snap, nid, keys, report, cancel, on_progress, incoming) -> NodeResult:
         type_name, params = snap.nodes[nid]
-        upstream = [e.src for e in snap.edges if e.dst == nid]
+        ports = incoming.get(nid, {})
+        upstream = [e.src for es in ports.values() for e in es]
         bad = [u for u in upstream if u not in keys]
         if bad:
             return NodeResult(nid, BLOCKED, error=f"waiting for failed input node(s) {sorted(set(bad))}")
         try:
             cls = node_type(type_name)
             params = cls.validate_params(params, nid)
-            check_required_inputs(snap, nid)
+            check_required_inputs(snap, nid, incoming)
         except (GraphError, KeyError) as exc:
             msg = exc.args[0] if isinstance(exc, KeyError) else str(exc)
             return NodeResult(nid, FAILED, error=msg, where=getattr(exc, "where", "") or "")
-        edges_by_port = {p.name: snap.inputs_of(nid, p.name) for p in cls.inputs}
+        edges_by_port = {p.name: ports.get(p.name, []) for p in cls.inputs}
         key_src = {
             "t": type_name, "v": cls.version, "p": params,
             "in": {port: [[keys[e.src], e.src_port] for e in es] for port, es in edges_by_port.items()},

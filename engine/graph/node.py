@@ -10,21 +10,11 @@ from typing import Any, Callable, ClassVar
 
 import numpy as np
 
-from engine.geometry.cancel import Cancelled  # one cancellation exception for kernels and nodes
+from engine.progress import Cancelled  # one cancellation exception for kernels and nodes
 
+from .codec import decode_outputs, encode_outputs, has_codecs
 from .errors import ParamError
 from .schema import Param, Port
-
-# Families decide a node's colour in the editor (paper Table 1 groups).
-FAMILY_COLOURS = {
-    "topology": (232, 176, 60),
-    "skeleton": (70, 150, 220),
-    "transform": (150, 110, 200),
-    "solid": (90, 180, 110),
-    "property": (210, 90, 90),
-}
-
-
 
 
 class CancelToken:
@@ -119,8 +109,9 @@ class NodeType:
     params: ClassVar[tuple[Param, ...]] = ()
     uses_rng: ClassVar[bool] = False
     # stateful nodes receive their previous result (ctx.previous) and may resume
-    # from it after a local edit (regrowth) instead of starting over; with
-    # encode_state / decode_state that result is also kept in the project file
+    # from it after a local edit (regrowth) instead of starting over; when the
+    # output ports' types have codecs (engine.graph.codec, used by the default
+    # encode_state / decode_state) that result is also kept in the project file
     stateful: ClassVar[bool] = False
     max_per_graph: ClassVar[int | None] = None
     # the parameter that sets the size of the work: what to lower when the
@@ -167,13 +158,21 @@ class NodeType:
     # -- stored state (stateful nodes) ------------------------------------
     def encode_state(self, outputs: dict[str, Any]) -> dict | None:
         """The outputs as a JSON-able dict for the project file, or None when
-        this node type cannot store them (its history is then not kept)."""
-        return None
+        this node type cannot store them (its history is then not kept).
+
+        By default the registered codecs of the output ports' types encode
+        them (`engine.graph.codec.encode_outputs`); None when a type has none."""
+        return encode_outputs(outputs, self.outputs)
 
     def decode_state(self, blob: dict, inputs: dict[str, Any]) -> dict[str, Any]:
         """Outputs rebuilt from `encode_state`'s dict against the node's current
-        inputs; raise ValueError when the blob is malformed or does not fit them."""
-        raise ValueError(f"node type {self.type_name!r} cannot restore a stored state")
+        inputs; raise ValueError when the blob is malformed or does not fit them.
+
+        By default the output ports' codecs decode it
+        (`engine.graph.codec.decode_outputs`)."""
+        if not has_codecs(self.outputs):
+            raise ValueError(f"node type {self.type_name!r} cannot restore a stored state")
+        return decode_outputs(blob, inputs, self.outputs)
 
     # -- schema helpers -------------------------------------------------
     @classmethod

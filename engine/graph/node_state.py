@@ -10,8 +10,9 @@ gives), so the project file keeps it::
 
 ``key`` is the evaluator's cache key when the result was made (same graph
 upstream and same parameters give the same key in any process); ``params``
-and ``seed`` are what the node was evaluated with; ``value`` is the node
-type's own JSON encoding of its outputs (``NodeType.encode_state``).  Only
+and ``seed`` are what the node was evaluated with; ``value`` is the JSON
+encoding of its outputs (``NodeType.encode_state``: by default the codecs
+of its output ports' types, `engine.graph.codec`).  Only
 the envelope is checked here; the value is checked when the node decodes it
 against its inputs.
 """

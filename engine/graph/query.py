@@ -111,3 +111,14 @@ def chain_around(doc, selected: str | None, chain: Sequence[str], *,
     for i in range(k, len(chain) - 1):
         found[chain[i + 1]] = downstream_of_type(doc, found[chain[i]], chain[i + 1])
     return found
+
+
+def upstream_closure(doc, node_id: str) -> set[str]:
+    """``node_id`` and every node it depends on (what must evaluate for it)."""
+    keep, stack = set(), [node_id]
+    while stack:
+        nid = stack.pop()
+        if nid not in keep:
+            keep.add(nid)
+            stack.extend(e.src for e in doc.inputs_of(nid))
+    return keep

@@ -15,29 +15,26 @@ from typing import Any, Callable
 
 from .errors import ParamError
 
-# Port types.  A "Skeleton" port accepts lines, surfaces and their transforms;
-# the later surface work plugs in by producing Skeleton values too.
-PORT_TYPES = (
-    "Point",
-    "EdgeChain",
-    "Skeleton",
-    "Solid",
-    "Voxel",
-    "Stiffness",
-    "Spectrum",
-    "Field",
-    "Mesh",
-    "TileSet",
-    "Tiling",
-    "PhasorFields",
-    "PhasorInfill",
-    "Energy",
-    "Design",
-    "RDFields",
-    "RDStructures",
-    "Contour",
-    "SurfaceReport",
-)
+# Port types are registered by the node layer (engine/nodes/port_types.py), so
+# the graph core names no family's values.
+_PORT_TYPES: set[str] = set()
+
+
+def register_port_types(*names: str) -> None:
+    """Declare value types ports may carry (idempotent)."""
+    _PORT_TYPES.update(names)
+
+
+def port_types() -> frozenset[str]:
+    """Every registered port type (the node layer's, loaded on first use)."""
+    _ensure_builtin_port_types()
+    return frozenset(_PORT_TYPES)
+
+
+def _ensure_builtin_port_types() -> None:
+    # loaded lazily, like the node types: engine.graph imports no node module at import time
+    import engine.nodes.port_types  # noqa: F401
+
 
 PARAM_KINDS = ("float", "int", "bool", "enum", "vec3", "str", "samples", "int_list", "json")
 
@@ -65,7 +62,9 @@ class Port:
     doc: str = ""
 
     def __post_init__(self):
-        if self.type not in PORT_TYPES:
+        if self.type not in _PORT_TYPES:
+            _ensure_builtin_port_types()
+        if self.type not in _PORT_TYPES:
             raise ValueError(f"port {self.name!r}: unknown port type {self.type!r}")
 
 
@@ -203,8 +202,11 @@ class Param:
     def allowed(self) -> str:
         """What `coerce` accepts, in words for messages: ``"[0.01, 0.99]"``,
         ``"integers in [2, 4096]"``, ``"one of x, y, z"``..."""
-        lo = "-inf" if self.minimum is None else f"{self.minimum:g}"
-        hi = "inf" if self.maximum is None else f"{self.maximum:g}"
+        def bound(v, none):
+            if v is None:
+                return none
+            return str(int(v)) if self.kind in ("int", "int_list") and float(v).is_integer() else f"{v:g}"
+        lo, hi = bound(self.minimum, "-inf"), bound(self.maximum, "inf")
         rng = f"[{lo}, {hi}]"
         return {"float": f"a finite number in {rng}", "int": f"an integer in {rng}",
                 "bool": "true or false", "enum": "one of " + ", ".join(map(str, self.choices)),

@@ -31,7 +31,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..geometry.cancel import report
+from engine.progress import next_chunk, report
 from . import _wfc_kernel as K
 from ._symmetry import grid_offsets
 from ._wfc_reference import ReferenceGrowth
@@ -41,7 +41,6 @@ from .tiling import UNASSIGNED, Tiling, resolve_rng
 
 __all__ = ["grow_tiling", "grow_tiling_reference", "neighbour_table"]
 
-_CHUNK_SECONDS = 0.04
 # From this many cells on, the minimal-entropy cell comes from a heap rather
 # than a scan of the grid (same choice; measured faster from ~50 x 50 on).
 _HEAP_MIN_CELLS = 2048
@@ -178,7 +177,8 @@ def _prepare(tileset, shape, hints, periodic, availability, fixed, fixed_defects
 
 
 def _drive(run, total: int, progress) -> None:
-    """Call ``run(budget) -> done`` in chunks of ~40 ms, reporting progress."""
+    """Call ``run(budget) -> done`` in chunks of ~40 ms (engine.progress.next_chunk),
+    reporting progress."""
     if progress is None:
         run(total)
         return
@@ -191,8 +191,7 @@ def _drive(run, total: int, progress) -> None:
         report(progress, done, total)
         if made == 0:
             break
-        dt = time.perf_counter() - t0
-        chunk = max(1, int(chunk * min(4.0, _CHUNK_SECONDS / max(dt, 1e-6))))
+        chunk = next_chunk(chunk, made, time.perf_counter() - t0)
 
 
 def _finish(tileset, p: _Problem, tiles, status, events, n_events, n_obs, remaining,

@@ -6,32 +6,31 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 
-from engine.batch.hints_text import parse_hints
 from engine.fileio import file_digest
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Field, LineElement, Skeleton, TilingValue
-from engine.growth import grow_tiling, list_tilesets, load_tileset, tiling_beams, tiling_image
-from engine.growth.regions import parse_region_hints, parse_region_map, region_hint_field
-from engine.growth.regrow import regrow_region, regrowth_start
-from engine.growth.tiling import UNASSIGNED
-from engine.growth.tiling_io import tiling_from_dict, tiling_to_dict
+from engine.geometry.values import Field, LineElement, Skeleton
+from engine.growth import list_tilesets, load_tileset, tiling_beams, tiling_image
 from engine.geometry.voxel_inputs import SOLVER_BYTES_PER_DOF, memory_estimate_bytes
 from engine.growth.properties import DEFAULT_RESOLUTION, VOID_MODES, homogenize_tiling
 
+from .growth_plan import (DERIVED_SEED, MAX_CELLS, REGROW_MARGIN, GrowthPlan, grid_shape,
+                          tiling_seed)
 from .properties import stiffness_from_result
 
-MAX_CELLS = 1_000_000
+__all__ = ["TileSetNode", "GrowNode", "TilingImageNode", "TilingBeamsNode", "TilingPropertiesNode",
+           "MAX_CELLS", "REGROW_MARGIN", "grid_shape", "tiling_properties_bytes", "tileset_params", "PROPERTIES_TOL"]
 # Peak bytes per grid cell of a growth: the wave (possible tiles per cell),
 # entropies, the recorded steps and the tiling; measured 92-129 B for TL+-
 # (11 tiles) and cubic-beams-mixed (71 tiles), so a base plus a little per tile.
 GROW_BYTES_PER_CELL = 128
 GROW_BYTES_PER_CELL_TILE = 2
-REGROW_MARGIN = 1  # cells cleared around a repainted region (square neighbourhood)
+PROPERTIES_TOL = 1e-6  # relative accuracy of the Tiling Properties solve (on the diagonal of C)
 
 
 def _tileset_names() -> tuple:
@@ -83,26 +82,39 @@ class TileSetNode(NodeType):
                 from None
 
 
-def grid_shape(size, tileset) -> tuple:
-    """``[nx, ny(, nz)]`` -> grid shape ``(ny, nx)`` / ``(nz, ny, nx)``."""
-    ndim = tileset.ndim
-    if len(size) != ndim:
-        want = "[nx, ny]" if ndim == 2 else "[nx, ny, nz]"
-        raise NodeInputError(f"size {list(size)} has {len(size)} entries but tile set "
-                             f"{tileset.name!r} is {ndim}D: give {want}", where="size")
-    if math.prod(size) > MAX_CELLS:
-        raise NodeInputError(f"size {list(size)} has {math.prod(size)} cells; at most "
-                             f"{MAX_CELLS} are allowed", where="size")
-    return tuple(int(s) for s in size[::-1])
+def tileset_params(source) -> dict:
+    """TileSet node parameters that load ``source``: ``{"name": ...}`` for a set
+    shipped in resources/tilesets (by set name), else ``{"path": file}`` for a
+    file stem, a path or a TileSet read from a file.
+
+    Raises ValueError when ``source`` does not load (the message of
+    ``load_tileset``) or is a TileSet held only in memory (no file to read)."""
+    from engine.growth import TileSet
+
+    if isinstance(source, TileSet):
+        ts = source
+    else:
+        text = str(source)
+        if text in TILESET_NAMES:
+            return {"name": text}
+        ts = load_tileset(text)
+    if ts.source is None:
+        raise ValueError(f"tile set {ts.name!r} was not read from a file; save it first")
+    shipped = list_tilesets().get(ts.name)
+    if shipped is not None and ts.name in TILESET_NAMES and Path(shipped).resolve() == Path(ts.source).resolve():
+        return {"name": ts.name}
+    return {"path": str(Path(ts.source).resolve())}
 
 
 @register
 class GrowNode(NodeType):
     """Virtual growth: fills a grid with tiles of the set by minimal-entropy
     wave-function collapse under the adjacency rules and frequency hints.
-    The seed comes from the document seed and the node id. Repainting the
-    hint regions regrows only the repainted cells; the tiling (with that
-    history) is kept in the project file."""
+    The seed comes from the document seed and the node id unless the
+    ``seed`` parameter gives one. Repainting the hint regions regrows only the
+    repainted cells; the tiling (with that history) is kept in the project
+    file. What runs is a `GrowthPlan` (engine.nodes.growth_plan), shared with
+    the command line and the Virtual Growth dock."""
 
     type_name = "Grow"
     title = "Grow"
@@ -127,6 +139,10 @@ class GrowNode(NodeType):
                   "0-9/a-z per cell, '.' = 0; empty = no regions"),
         Param("region_hints", "str", "",
               doc="hints per painted label, e.g. '1: T=3,+=1 | 2: L=2'; label 0 uses `hints`"),
+        # 63-bit: study seeds are engine.batch.sample_seed values
+        Param("seed", "int", DERIVED_SEED, DERIVED_SEED, 2**63 - 1,
+              doc="tiling seed (an integer >= 0) used as is; -1 = derived from the document "
+                  "seed and the node id"),
     )
 
     memory_param = "size"
@@ -138,85 +154,12 @@ class GrowNode(NodeType):
         return math.prod(params["size"]) * (GROW_BYTES_PER_CELL + GROW_BYTES_PER_CELL_TILE * n_tiles)
 
     def evaluate(self, inputs, params, ctx):
-        ts = inputs["tileset"]
-        shape = grid_shape(params["size"], ts)
-        try:
-            hints = parse_hints(params["hints"], ts)
-        except ValueError as exc:
-            raise NodeInputError(str(exc), where="hints") from None
-        field, labels = self._region_field(ts, shape, hints, params)
-        availability = params["availability"] or None
+        plan = GrowthPlan.from_params(params, inputs["tileset"], tiling_seed(params, ctx.seed))
         previous = ctx.previous.get("tiling") if ctx.previous else None
-        changed = self._changed_cells(previous, ts, shape, params, labels, field, ctx)
-        if changed is not None and not changed.any():
-            # the same painted cells (a region text that parses alike, or a result
-            # restored from a file under an older cache key): the tiling stays
-            tiling = previous.tiling
-            return {"tiling": TilingValue(tiling, ts, np.zeros((0, 2), np.int32), tiling.tiles)}
-        if changed is not None:
-            # Local regrowth (paper's repainting): only repainted cells plus a margin
-            # grow again; every other tile stays byte-identical.
-            start = regrowth_start(previous.tiling, changed, margin=REGROW_MARGIN)
-            tiling = regrow_region(previous.tiling, ts, changed, margin=REGROW_MARGIN,
-                                   hints=field if field is not None else hints, rng=ctx.seed,
-                                   record_steps=True, progress=ctx.progress)
-        else:
-            start = np.full(shape, UNASSIGNED, np.int32)
-            tiling = grow_tiling(ts, shape, hints=field if field is not None else hints,
-                                 periodic=params["periodic"], availability=availability, rng=ctx.seed,
-                                 record_steps=True, progress=ctx.progress)
-        return {"tiling": TilingValue(tiling, ts, tiling.steps, start)}
-
-    def encode_state(self, outputs):
-        tv = outputs["tiling"]
-        return {"tiling": tiling_to_dict(tv.tiling, tv.tileset)}
-
-    def decode_state(self, blob, inputs):
-        ts = inputs["tileset"]
-        if ts is None:
-            raise ValueError("no tile set is connected")
-        if not isinstance(blob, dict) or not isinstance(blob.get("tiling"), dict):
-            raise ValueError("expected {'tiling': <tiling document>}")
-        tiling = tiling_from_dict(blob["tiling"], ts, source="stored tiling")
-        return {"tiling": TilingValue(tiling, ts)}
-
-    @staticmethod
-    def _region_field(ts, shape, hints, params):
-        try:
-            labels = parse_region_map(params["regions"], shape)
-        except ValueError as exc:
-            raise NodeInputError(str(exc), where="regions") from None
-        if labels is None:
-            return None, None
-        try:
-            per_label = parse_region_hints(params["region_hints"], lambda text: parse_hints(text, ts))
-        except ValueError as exc:
-            raise NodeInputError(str(exc), where="region_hints") from None
-        return region_hint_field(ts, shape, labels, hints, per_label), labels
-
-    @staticmethod
-    def _changed_cells(previous, ts, shape, params, labels, field, ctx):
-        """Bool mask of the cells to regrow when at most the painted regions
-        changed since the last evaluation of this node (same set, size, seed,
-        periodicity; all False when nothing did); else None (grow afresh)."""
         prev_params = ctx.previous_params or {}
-        same = (previous is not None and previous.tileset is ts and previous.tiling.tiles.shape == tuple(shape)
-                and not params["availability"]
-                and all(prev_params.get(k) == params[k] for k in ("size", "periodic", "hints", "availability"))
-                and ctx.previous_seed == ctx.seed)
-        if not same:
-            return None
-        try:
-            old = parse_region_map(prev_params.get("regions", ""), shape)
-        except ValueError:
-            return None
-        old = np.zeros(shape, np.int64) if old is None else old
-        new = np.zeros(shape, np.int64) if labels is None else labels
-        if prev_params.get("region_hints") != params["region_hints"]:
-            changed = (old != new) | (new != 0) | (old != 0)
-        else:
-            changed = old != new
-        return changed
+        prev_seed = None if ctx.previous_seed is None else tiling_seed(prev_params, ctx.previous_seed)
+        return {"tiling": plan.evaluate(previous, prev_params, prev_seed, progress=ctx.progress)}
+
 
 
 @register
@@ -323,7 +266,7 @@ class TilingPropertiesNode(NodeType):
             result = homogenize_tiling(tv.tiling, tv.tileset, E=params["E"], nu=params["nu"],
                                        resolution=res, line_width=params["line_width"] or None,
                                        radius=params["radius"], void=params["void"],
-                                       progress=ctx.progress)
+                                       tol=PROPERTIES_TOL, progress=ctx.progress)
         except ValueError as exc:
             raise NodeInputError(str(exc)) from None
         n = res or (20 if tv.ndim == 2 else 10)

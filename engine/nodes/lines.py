@@ -9,7 +9,7 @@ from engine.geometry.thickness import thickness_profile
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import LineElement, Skeleton
+from engine.geometry.values import LineElement, Skeleton
 
 _TOL = 1e-9
 

@@ -7,30 +7,36 @@ Painting is data: every brush stroke in the window is one
 ``SetParam(node, "strokes", old + [stroke.to_dict()])``.  PhasorFields and
 PhasorNoise are stateful, so a stroke appended to the list repaints only its
 own cells, and the noise resamples and re-aligns only the kernels there.
+
+What runs is :class:`engine.nodes.phasor_session.PhasorInfillSession` (the
+fields from the parameters, sampling, the local update, slices), which the
+"Phasor Infill" dock and ``mesoforge phasor`` call too.
 """
 
 from __future__ import annotations
 
-import base64
-import hashlib
 import json
 import math
-import zlib
-from dataclasses import replace
 
 import numpy as np
 
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Field, MeshValue, PhasorFieldsValue, SliceEnergy
-from engine.phasor.field_init import DEFAULT_SPEC, fields_from_spec
-from engine.phasor.strokes import Stroke, apply_stroke, stroke_weights
+from engine.geometry.values import Field, MeshValue
+from engine.phasor.values import PhasorFieldsValue
+from engine.phasor.field_init import DEFAULT_SPEC
+from engine.phasor.strokes import Stroke, stroke_weights
+
+from .phasor_session import (MAX_FIELD_CELLS, NoiseOptions, PhasorInfillSession, fields_box, grid_shape,
+                             initial_fields, paint, union_box)
+
+__all__ = ["MeshImportNode", "PhasorFieldsNode", "PhasorNoiseNode", "PhasorSliceNode", "MAX_FIELD_CELLS",
+           "grid_shape", "slice_pixels", "print_memory_estimate"]
 
 DEFAULT_SPEC_TEXT = json.dumps(DEFAULT_SPEC)
 SHOW = ("diamonds", "p_v", "p_w", "singularity")
 SHOW_S_MAX = 10.0  # singularity images are clipped here (inf where G = 0) for display
-MAX_FIELD_CELLS = 256 ** 3
 # Peak bytes per control-field cell (D as a 3x3 frame, F, Gamma, the stroke
 # weights and their temporaries) and per slice pixel (the sample points, the
 # complex noise of both families, the sawtooth, inside and diamond masks).
@@ -81,22 +87,11 @@ def _same_mesh(a, b) -> bool:
     return np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
 
 
-def _union(a, b):
-    if a[0].stop <= a[0].start:
-        return b
-    if b[0].stop <= b[0].start:
-        return a
-    return tuple(slice(min(x.start, y.start), max(x.stop, y.stop)) for x, y in zip(a, b))
-
-
-_EMPTY = (slice(0, 0),) * 3
-
-
 def _weight_box(fields, stroke):
     """[z, y, x] box of the cells a stroke paints (non-zero weight), as apply_stroke reports it."""
     w = stroke_weights(fields, stroke) > 0
     if not w.any():
-        return _EMPTY
+        return (slice(0, 0),) * 3
     box = []
     for axis in range(3):
         hit = np.flatnonzero(w.any(axis=tuple(a for a in range(3) if a != axis)))
@@ -135,14 +130,6 @@ class MeshImportNode(NodeType):
 
 # ------------------------------------------------------------------ PhasorFields
 
-def grid_shape(lo, hi, resolution: int) -> tuple:
-    """(nz, ny, nx): ``resolution`` cells along the box's longest axis, the
-    others in proportion (at least 2)."""
-    ext = np.asarray(hi, float) - np.asarray(lo, float)
-    n = [max(2, int(round(resolution * e / ext.max()))) for e in ext]
-    return tuple(n[::-1])
-
-
 @register
 class PhasorFieldsNode(NodeType):
     """Control fields of phasor infill: direction D, frequency F (cells/mm) and
@@ -179,7 +166,7 @@ class PhasorFieldsNode(NodeType):
 
     def evaluate(self, inputs, params, ctx):
         domain = inputs.get("domain")
-        lo, hi = self._box(domain, params)
+        lo, hi = fields_box(domain, params)
         shape = grid_shape(lo, hi, params["resolution"])
         strokes = [Stroke.from_dict(d) for d in params["strokes"]]
         prev = ctx.previous.get("fields") if ctx.previous else None
@@ -194,74 +181,21 @@ class PhasorFieldsNode(NodeType):
                 k += 1
             if k == len(old):
                 # the previous strokes are a prefix: paint only the new ones
-                fields, changed = self._paint(prev.fields, strokes[k:], 0)
+                fields, changed = paint(prev.fields, strokes[k:], 0)
                 return {"fields": PhasorFieldsValue(fields, domain, changed, len(strokes))}
-        fields = self._initial(domain, lo, hi, shape, params)
+        fields = initial_fields(domain, params)
         if same_base:
             # from scratch, but only cells under the differing strokes differ
-            fields, changed = self._paint(fields, strokes, k)
+            fields, changed = paint(fields, strokes, k)
             for d in old[k:]:
-                changed = _union(changed, _weight_box(fields, Stroke.from_dict(d)))
+                changed = union_box(changed, _weight_box(fields, Stroke.from_dict(d)))
         else:
-            fields, _ = self._paint(fields, strokes, len(strokes))
+            fields, _ = paint(fields, strokes, len(strokes))
             changed = None
         return {"fields": PhasorFieldsValue(fields, domain, changed, len(strokes))}
 
-    @staticmethod
-    def _box(domain, params):
-        if domain is not None:
-            from engine.phasor.domain import box_of
-            return box_of(domain, params["margin"])
-        lo, hi = np.array(params["lo"]), np.array(params["hi"])
-        if np.any(hi <= lo):
-            raise NodeInputError(f"hi {params['hi']} must exceed lo {params['lo']} on every axis (mm)",
-                                 where="hi")
-        return lo, hi
-
-    @staticmethod
-    def _initial(domain, lo, hi, shape, params):
-        if math.prod(shape) > MAX_FIELD_CELLS:
-            raise NodeInputError(f"a grid of {shape[::-1]} cells is more than {MAX_FIELD_CELLS}",
-                                 where="resolution")
-        try:
-            spec = json.loads(params["spec"]) if params["spec"].strip() else {}
-        except ValueError as exc:
-            raise NodeInputError(f"spec is not valid JSON: {exc}", where="spec") from None
-        try:
-            return fields_from_spec(spec, lo=lo, hi=hi, shape=shape, mesh=domain)
-        except ValueError as exc:
-            raise NodeInputError(f"spec: {exc}", where="spec") from None
-
-    @staticmethod
-    def _paint(fields, strokes, first):
-        """Apply every stroke; return the union box of those from index ``first`` on."""
-        changed = _EMPTY
-        for i, stroke in enumerate(strokes):
-            fields, box = apply_stroke(fields, stroke)
-            if i >= first:
-                changed = _union(changed, box)
-        return fields, changed
-
 
 # ------------------------------------------------------------------ PhasorNoise
-
-def _fields_digest(fields) -> str:
-    h = hashlib.sha256()
-    for a in (fields.direction, fields.frequency, fields.spread, fields.lo, fields.hi):
-        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
-    return h.hexdigest()
-
-
-def _pack(a) -> str:
-    return base64.b64encode(zlib.compress(np.ascontiguousarray(a, "<f8").tobytes(), 6)).decode("ascii")
-
-
-def _unpack(text, n) -> np.ndarray:
-    a = np.frombuffer(zlib.decompress(base64.b64decode(text.encode("ascii"), validate=True)), "<f8")
-    if a.shape != (n,):
-        raise ValueError(f"expected {n} stored phases, found {a.size}")
-    return a.astype(np.float64)
-
 
 @register
 class PhasorNoiseNode(NodeType):
@@ -288,65 +222,20 @@ class PhasorNoiseNode(NodeType):
     )
 
     def evaluate(self, inputs, params, ctx):
-        from engine.phasor.incremental import changed_cells, update_infill
-        from engine.phasor.infill import sample_infill
-
         fv = inputs["fields"]
-        fields = fv.fields
         prev = ctx.previous.get("infill") if ctx.previous else None
         pp = ctx.previous_params or {}
+        session = PhasorInfillSession(fv.fields, prev, fv.domain, NoiseOptions.from_params(params))
         if (prev is not None and ctx.previous_seed == ctx.seed
                 and all(pp.get(k) == params[k] for k in ("per_cell", "c", "iterations"))
-                and params["c"] / fields.min_frequency() == prev.kernels.radius):
-            changed = changed_cells(prev.fields, fields)
-            if changed is not None:
-                infill = update_infill(prev, fields, changed, iterations=params["iterations"],
-                                       filtered=params["filtered"], filter_scale=params["filter_scale"],
-                                       progress=ctx.progress)
-                return {"infill": replace(infill, domain=fv.domain)}
+                and session.can_update()):
+            return {"infill": session.update(progress=ctx.progress).infill}
         try:
-            infill = sample_infill(fields, domain=fv.domain, per_cell=params["per_cell"], c=params["c"],
-                                   iterations=params["iterations"], filtered=params["filtered"],
-                                   filter_scale=params["filter_scale"], rng=ctx.seed,
-                                   progress=ctx.progress)
+            session = session.sample(ctx.seed, progress=ctx.progress)
         except ValueError as exc:  # too many kernels for the box and F_min
             raise NodeInputError(str(exc), where="per_cell") from None
-        return {"infill": infill}
+        return {"infill": session.infill}
 
-    # The oscillators are what a fresh sample of the current fields gives (a
-    # resample reuses the same random draws), so only the phases, which carry
-    # the history of local re-alignments, are stored.
-    def encode_state(self, outputs):
-        infill = outputs["infill"]
-        k = infill.kernels
-        return {"n": k.n, "seed": k.seed, "per_cell": k.info.get("per_cell"), "c": k.info.get("c"),
-                "iterations": infill.iterations, "filtered": infill.filtered,
-                "filter_scale": infill.filter_scale, "fields_sha256": _fields_digest(infill.fields),
-                "phase_v": _pack(k.phase_v), "phase_w": _pack(k.phase_w)}
-
-    def decode_state(self, blob, inputs):
-        from engine.phasor.attenuation import attenuation_grid
-        from engine.phasor.infill import PhasorInfill
-        from engine.phasor.sampling import sample_kernels
-
-        fv = inputs.get("fields")
-        if fv is None:
-            raise ValueError("no fields are connected")
-        try:
-            n, seed, per_cell, c = int(blob["n"]), int(blob["seed"]), int(blob["per_cell"]), float(blob["c"])
-            digest = blob["fields_sha256"]
-            options = (int(blob["iterations"]), bool(blob["filtered"]), float(blob["filter_scale"]))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ValueError(f"malformed stored noise ({exc!r})") from None
-        if digest != _fields_digest(fv.fields):
-            raise ValueError("the fields changed since the noise was stored")
-        kernels = sample_kernels(fv.fields, per_cell=per_cell, c=c, rng=seed)
-        if kernels.n != n:
-            raise ValueError(f"expected {n} kernels, sampling gives {kernels.n}")
-        kernels = kernels.with_phases(_unpack(blob["phase_v"], n), _unpack(blob["phase_w"], n))
-        infill = PhasorInfill(kernels, fv.fields, fv.domain, options[1], options[2],
-                              attenuation_grid(fv.fields, radius=kernels.radius), options[0])
-        return {"infill": infill}
 
 
 # ------------------------------------------------------------------ PhasorSlice
@@ -386,21 +275,22 @@ class PhasorSliceNode(NodeType):
         return slice_pixels(f.lo, f.hi, params["axis"], params["pixel"]) * SLICE_BYTES_PER_PIXEL
 
     def evaluate(self, inputs, params, ctx):
-        from engine.phasor.infill import SINGULARITY_THRESHOLD, check_pixel, infill_slice
+        from engine.phasor.infill import check_pixel
 
         infill = inputs["infill"]
         try:
             check_pixel(infill.fields, params["pixel"])
         except ValueError as exc:
             raise NodeInputError(str(exc), where="pixel") from None
+        session = PhasorInfillSession.of_infill(infill)
         try:
-            result = infill_slice(infill, params["axis"], params["position"], params["pixel"],
-                                  engine=params["engine"], progress=ctx.progress)
+            result = session.slice_at(params["axis"], params["position"], params["pixel"],
+                                      engine=params["engine"], progress=ctx.progress)
         except ValueError as exc:
             where = "position" if str(exc).startswith("position") else "infill"
             raise NodeInputError(str(exc), where=where) from None
         ctx.check()
-        energy = self._energy(result, SINGULARITY_THRESHOLD)
+        energy = session.energy(result)
         show = params["show"]
         if show == "diamonds":
             values = result.diamonds.astype(np.float64)
@@ -410,11 +300,3 @@ class PhasorSliceNode(NodeType):
             s_v, s_w = result.singularity()
             values = np.nan_to_num(np.clip(np.fmax(s_v, s_w), 0.0, SHOW_S_MAX), nan=0.0)
         return {"image": Field(values, result.lo, result.hi), "energy": energy}
-
-    @staticmethod
-    def _energy(result, q):
-        try:
-            e = result.energy(q)
-        except ValueError:  # the slice misses the part
-            return SliceEnergy(math.nan, math.nan, math.nan, q, 0, result.state, result.engine)
-        return SliceEnergy(e["either"], e["v"], e["w"], q, e["pixels"], result.state, result.engine)

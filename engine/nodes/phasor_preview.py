@@ -14,7 +14,8 @@ import numpy as np
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Solid
+from engine.geometry.values import Solid
+from engine.progress import stage
 
 AUTO_EDGE = 10.0  # mm, edge of the default sub-box (lo = hi) at the centre of the fields' box
 NOISES = ("aligned", "raw")
@@ -27,13 +28,6 @@ def auto_sub_box(fields) -> tuple:
     centre = 0.5 * (fields.lo + fields.hi)
     half = 0.5 * np.minimum(AUTO_EDGE, fields.hi - fields.lo)
     return centre - half, centre + half
-
-
-def _stage(progress, start, share):
-    """A kernel's progress mapped onto [start, start + share] of the node's bar."""
-    def inner(done, total):
-        return progress(start + share * done / max(total, 1), 1.0)
-    return inner
 
 
 @register
@@ -72,7 +66,7 @@ class PhasorPreviewNode(NodeType):
         state = "raw" if params["noise"] == "raw" else None
         try:
             volume = diamond_volume(infill, lo, hi, voxel=params["voxel"], state=state,
-                                    engine=params["engine"], progress=_stage(ctx.progress, 0.0, SAMPLING_SHARE))
+                                    engine=params["engine"], progress=stage(ctx.progress, 0.0, SAMPLING_SHARE))
         except ValueError as exc:
             text = str(exc)
             where = next((p for p in ("lo", "hi", "voxel") if text.startswith(p + ":")), "infill")
@@ -81,7 +75,7 @@ class PhasorPreviewNode(NodeType):
         if not (volume.indicator < 0).any():
             raise NodeInputError("no diamond cell lies in the sub-box (inside the part): move lo and hi "
                                  "into the part", where="lo")
-        verts, faces = diamond_surface(volume, progress=_stage(ctx.progress, SAMPLING_SHARE,
+        verts, faces = diamond_surface(volume, progress=stage(ctx.progress, SAMPLING_SHARE,
                                                               1.0 - SAMPLING_SHARE))
         extent = volume.hi - volume.lo
         return {"solid": Solid(volume.indicator, verts - volume.lo, faces, float(extent.max()), periodic=False)}

@@ -9,7 +9,7 @@ from engine.geometry.resample import resample_periodic
 from engine.geometry.voxel_inputs import SOLVER_BYTES_PER_DOF, memory_estimate_bytes
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Stiffness
+from engine.physics.values import Stiffness
 from engine.physics.elastic import engineering_constants, is_singular, symmetry_class, zener_ratio
 from engine.physics.homogenize3d import homogenize_voxels
 

@@ -12,6 +12,8 @@ Painting is data, as for phasor infill: a solid-region stroke is one
 structure one ``SetParam(grow, "edits", old + [edit])``.  RDGrow is
 stateful: when only edits were appended it applies them to its previous
 state and regrows locally; the grown state is kept in the project file.
+What RDGrow runs is `engine.nodes.rd_session.RDGrowthSession`, the object
+the RD dock's live growth and ``mesoforge rd`` (through this node) share.
 """
 
 from __future__ import annotations
@@ -24,9 +26,12 @@ from engine.fileio import file_digest
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import ContourValue, Field, RDFieldsValue, Solid
+from engine.geometry.values import Field, Solid
+from engine.rd.values import ContourValue, RDFieldsValue
+from engine.progress import stage
 
 from . import rd_state
+from .grid_size import grid_shape_of
 
 MAX_FIELD_CELLS = 4_000_000      # growth grid: 2000 x 2000 or 160^3
 # Peak bytes per growth-grid cell, by dimension: upsampled fields, the
@@ -41,13 +46,6 @@ COMBINE = ("union", "lattice", "membrane")
 # paper Table 2: relative thickness per direction (2D: L-beam / bridge; 3D: MBB / chair)
 PAPER_MU = {2: (0.15, 0.4), 3: (0.2, 0.25, 0.25)}
 FILTER_DELTA = 0.01              # paper Table 1, delta_i
-
-
-def _stage(progress, start, share):
-    """A kernel's progress mapped onto [start, start + share] of the node's bar."""
-    def inner(done, total):
-        return progress(start + share * done / max(total, 1), 1.0)
-    return inner
 
 
 # ------------------------------------------------------------------ brush data
@@ -248,14 +246,8 @@ def growth_shape(resolution, fields) -> tuple:
     d = fields.ndim
     if not resolution:
         return fields.grid_shape
-    if len(resolution) != d:
-        want = "[nx, ny]" if d == 2 else "[nx, ny, nz]"
-        raise NodeInputError(f"resolution {list(resolution)} has {len(resolution)} entries but the fields are "
-                             f"{d}D: give {want} (or [] for the fields' grid)", where="resolution")
-    if math.prod(resolution) > MAX_FIELD_CELLS:
-        raise NodeInputError(f"resolution {list(resolution)} has {math.prod(resolution)} cells; at most "
-                             f"{MAX_FIELD_CELLS} are allowed", where="resolution")
-    return tuple(int(n) for n in resolution[::-1])
+    return grid_shape_of(resolution, d, MAX_FIELD_CELLS, where="resolution", owner="the fields are",
+                         hint=" (or [] for the fields' grid)")
 
 
 def growth_fields(fields: RDFieldsValue, shape) -> RDFieldsValue:
@@ -341,23 +333,20 @@ class RDGrowNode(NodeType):
         return math.prod(shape) * GROW_BYTES_PER_CELL[d]
 
     def evaluate(self, inputs, params, ctx):
+        from .rd_session import RDGrowthSession
+
         source = inputs["rdfields"]
-        shape = growth_shape(params["resolution"], source)
-        dirs = selected_directions(params["directions"], source.ndim)
         previous = (ctx.previous or {}).get("structures")
         new_edits = self._appended_edits(previous, source, params, ctx)
         if new_edits == []:
             # nothing changed that the growth sees (e.g. a result restored under an older key)
             return {"structures": previous}
-        try:
-            if new_edits is not None:
-                result = rd_state.regrow_all(previous, new_edits, params, progress=ctx.progress)
-            else:
-                fields = growth_fields(source, shape)
-                ctx.check()
-                result = rd_state.grow_all(fields, dirs, params, seed=ctx.seed, progress=ctx.progress)
-        except rd_state.GrowthInputError as exc:
-            raise NodeInputError(str(exc), where=exc.where) from None
+        if new_edits is not None:
+            result = RDGrowthSession.of_value(previous, params).regrow(new_edits, progress=ctx.progress)
+        else:
+            session = RDGrowthSession(source, params, ctx.seed)
+            ctx.check()
+            result = session.grow(progress=ctx.progress)
         return {"structures": result}
 
     @staticmethod
@@ -375,14 +364,6 @@ class RDGrowNode(NodeType):
             return None
         return new[len(old):]
 
-    def encode_state(self, outputs):
-        return rd_state.encode_structures(outputs["structures"])
-
-    def decode_state(self, blob, inputs):
-        source = inputs.get("rdfields")
-        if source is None:
-            raise ValueError("no RD fields are connected")
-        return {"structures": rd_state.decode_structures(blob, source)}
 
 
 # ------------------------------------------------------------------ RDCompile
@@ -460,7 +441,7 @@ class RDCompileNode(NodeType):
                 structures, mu=mu, delta=FILTER_DELTA, rho=f.rho, iso=st.iso, gamma=f.gamma,
                 combination="membrane" if mode == "membrane" else "lattice",
                 h_min=params["min_member"] or None, wavelength=wavelength,
-                progress=_stage(ctx.progress, 0.0, 0.5))
+                progress=stage(ctx.progress, 0.0, 0.5))
         except ValueError as exc:
             raise NodeInputError(str(exc), where="structures") from None
         ctx.check()
@@ -480,7 +461,7 @@ class RDCompileNode(NodeType):
                           float((f.hi - f.lo).max()), periodic=False)
         else:
             contour = ContourValue((), np.zeros(2), np.ones(2))
-            verts, faces = structure_mesh(density, spacing=1.0, progress=_stage(ctx.progress, 0.5, 0.5))
+            verts, faces = structure_mesh(density, spacing=1.0, progress=stage(ctx.progress, 0.5, 0.5))
             solid = Solid(0.5 - density, verts * cell, faces, float((f.hi - f.lo).max()), periodic=False)
         return {"field": field, "solid": solid, "contour": contour}
 

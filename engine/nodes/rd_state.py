@@ -1,6 +1,7 @@
-"""What the RDGrow node runs and keeps: growth of every direction, local
-regrowth after brush edits, and the compact form of the grown state stored
-in the project file.
+"""What the RDGrow node keeps and the pieces its growth session
+(`engine.nodes.rd_session`) is made of: the kernel options, the canonical
+state, local regrowth after brush edits, and the compact form of the grown
+state stored in the project file.
 
 The kept state is *canonical*: after every growth or regrowth ``u`` and
 ``v`` are clipped to [0, 1] and quantised to 1/255 (held as float64), so
@@ -26,8 +27,8 @@ import zlib
 
 import numpy as np
 
-from engine.geometry.cancel import Cancelled
-from engine.graph.values import RDFieldsValue, RDStructuresValue
+from engine.progress import Cancelled, stage
+from engine.rd.values import RDFieldsValue, RDStructuresValue
 
 BLOB_FORMAT = "mesoforge-rd-structures/1"
 MIN_MARGIN = 4             # cells around an edit's box that regrow with it (at least; else its radius)
@@ -46,7 +47,7 @@ _WHERE = ((r"infill space|\biso\b", "iso"), (r"\bdt\b", "dt"), (r"\bseeds?\b", "
           (r"\beps\b", "eps"))
 
 
-def _where(message: str) -> str:
+def where_of(message: str) -> str:
     """The node parameter a kernel's message is about ("rdfields": the input)."""
     for pattern, where in _WHERE:
         if re.search(pattern, message):
@@ -70,7 +71,7 @@ def seed_radius(shape) -> float:
 def growth_options(fields: RDFieldsValue, params: dict, seed: int) -> dict:
     """The ``engine.rd.growth.grow`` keywords the node uses, shared by every
     direction (the same seeds for all): iso, params, seeds, seed_radius, eps,
-    max_steps.  The RD dock's live growth uses these to match the node."""
+    max_steps.  `engine.nodes.rd_session.RDGrowthSession` grows with these."""
     from engine.rd.growth import place_seeds
 
     shape = fields.grid_shape
@@ -106,43 +107,8 @@ def _structure(state) -> np.ndarray:
     return (1.0 - state.u).astype(np.float32)
 
 
-def _stage(progress, k, n):
-    if progress is None:
-        return None
-
-    def inner(done, total):
-        return progress(k + done / max(total, 1), n)
-    return inner
-
-
-def grow_all(fields: RDFieldsValue, directions, params: dict, *, seed: int, progress=None) -> RDStructuresValue:
-    """Grow every direction of ``directions`` from its seeds, then apply
-    ``params["edits"]`` one after the other (as a series of regrowths would)."""
-    from engine.rd.growth import grow
-
-    opts = growth_options(fields, params, seed)
-    n_cells = math.prod(fields.grid_shape)
-    runs = []
-    total = len(directions) * (1 + len(params["edits"]))
-    for k, i in enumerate(directions):
-        try:
-            res = grow(fields.rho, fields.rotation, direction=i, gamma_map=fields.gamma,
-                       progress=_stage(progress, k, total), **opts)
-        except ValueError as exc:
-            raise GrowthInputError(str(exc), _where(str(exc))) from None
-        if res.stop_reason == "cancelled":
-            raise Cancelled(f"growth of direction {i} cancelled at step {res.steps}")
-        runs.append(_Run(canonical_state(res.state), res.stop_reason, res.stop_step, res.wall_time,
-                         res.steps * n_cells, res.history))
-    value = _value(fields, directions, params["iso"], runs, edits=(), regrown=False, changed=None)
-    if params["edits"]:
-        value = regrow_all(value, params["edits"], params, progress=progress, done=len(directions),
-                           total=total)
-    return value
-
-
-class _Run:
-    """One direction's last run: state, why and where it stopped, seconds,
+class GrowthRun:
+    """One direction's last run (what `structures_value` is made of): state, why and where it stopped, seconds,
     cell updates (cells x steps) and its G history."""
 
     def __init__(self, state, reason, stop_step, seconds, updates, history):
@@ -151,7 +117,9 @@ class _Run:
         self.history = np.asarray(history, dtype=np.float64).reshape(-1, 2)
 
 
-def _value(fields, directions, iso, runs, *, edits, regrown, changed, rate=None) -> RDStructuresValue:
+def structures_value(fields, directions, iso, runs, *, edits, regrown, changed, rate=None) -> RDStructuresValue:
+    """The node's value of one `GrowthRun` per direction on the growth-grid ``fields``;
+    ``rate`` (cell updates per second) defaults to the runs' updates over their seconds."""
     seconds = sum(r.seconds for r in runs)
     if rate is None:
         rate = sum(r.updates for r in runs) / seconds if seconds > 0 else 0.0
@@ -191,7 +159,9 @@ def regrow_all(previous: RDStructuresValue, new_edits, params: dict, *, progress
                total=None) -> RDStructuresValue:
     """Apply ``new_edits`` one after the other to every direction of
     ``previous`` and regrow each locally (engine.rd.regrow): only a window
-    around the edit changes, everything else keeps its bytes."""
+    around the edit changes, everything else keeps its bytes.  ``progress`` is
+    reported on a bar of ``total`` equal shares of which ``done`` are behind
+    (one share per direction and edit).  Raises GrowthInputError, Cancelled."""
     from engine.rd.regrow import regrow
 
     fields = previous.fields
@@ -215,7 +185,7 @@ def regrow_all(previous: RDStructuresValue, new_edits, params: dict, *, progress
             try:
                 res = regrow(states[j], fields.rho, fields.rotation, region=region, mode=edit["mode"],
                              gamma_map=fields.gamma, iso=previous.iso, margin=margin, eps=params["eps"],
-                             max_steps=params["max_steps"], progress=_stage(progress, k, total))
+                             max_steps=params["max_steps"], progress=stage(progress, k / total, 1 / total))
             except ValueError as exc:
                 raise GrowthInputError(f"edit {index}: {exc}", "edits") from None
             if res.stop_reason == "cancelled":
@@ -223,7 +193,7 @@ def regrow_all(previous: RDStructuresValue, new_edits, params: dict, *, progress
             states[j] = canonical_state(res.state)
             window = tuple((s.start, s.stop) for s in res.box)
             cells = math.prod(b - a for a, b in window)
-            last[j] = _Run(states[j], res.stop_reason, res.steps, res.wall_time, cells * res.steps, res.history)
+            last[j] = GrowthRun(states[j], res.stop_reason, res.steps, res.wall_time, cells * res.steps, res.history)
             seconds += res.wall_time
             updates += cells * res.steps
             box = _union(box, window)
@@ -231,8 +201,8 @@ def regrow_all(previous: RDStructuresValue, new_edits, params: dict, *, progress
     if not new_edits:
         return previous
     rate = updates / seconds if seconds > 0 else 0.0
-    return _value(fields, previous.directions, previous.iso, last, edits=tuple(previous.edits) + tuple(new_edits),
-                  regrown=True, changed=box, rate=rate)
+    return structures_value(fields, previous.directions, previous.iso, last,
+                            edits=tuple(previous.edits) + tuple(new_edits), regrown=True, changed=box, rate=rate)
 
 
 # ------------------------------------------------------------------ project-file blob
@@ -300,12 +270,12 @@ def decode_structures(blob: dict, source: RDFieldsValue) -> RDStructuresValue:
                                   str(st["inputs"]), history))
         _check_digests(states, fields, float(blob["iso"]))
         histories = [_unpack64(g).reshape(-1, 2) for g in blob["g_history"]]
-        runs = [_Run(*args, 0.0, g) for args, g in zip(
+        runs = [GrowthRun(*args, 0.0, g) for args, g in zip(
             zip(states, blob["stop_reasons"], blob["stop_steps"], blob["seconds"]), histories)]
         if not runs or not len(runs) == len(blob["directions"]) == len(blob["stop_reasons"]) == len(histories):
             raise ValueError("the stored growth has a state per direction missing")
         changed = blob.get("changed")
-        return _value(fields, blob["directions"], float(blob["iso"]), runs, edits=tuple(blob["edits"]),
+        return structures_value(fields, blob["directions"], float(blob["iso"]), runs, edits=tuple(blob["edits"]),
                       regrown=bool(blob["regrown"]),
                       changed=None if changed is None else tuple((int(a), int(b)) for a, b in changed),
                       rate=float(blob["cell_updates_per_second"]))

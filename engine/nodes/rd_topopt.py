@@ -16,7 +16,7 @@ import numpy as np
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import DesignValue
+from engine.topopt.values import DesignValue
 
 # node preset -> (engine preset, dimension, default resolution [nx, ny(, nz)])
 PRESETS = {

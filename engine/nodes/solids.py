@@ -12,7 +12,7 @@ from engine.geometry.sdf_triangles import surface_sdf_grid
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Solid, VoxelModel
+from engine.geometry.values import Solid, VoxelModel
 
 # Peak bytes per grid point of an Object evaluation: the float64 distance field
 # of each batch, their union and the marching-cubes mesh (a beam cell measured

@@ -58,7 +58,8 @@ from engine.geometry.surfaces.thin_shell import solve_thin_shell
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Skeleton, SurfaceElement, SurfaceReport
+from engine.geometry.surfaces.values import SurfaceReport
+from engine.geometry.values import Skeleton, SurfaceElement
 
 from .lines import order_chains
 

@@ -7,7 +7,7 @@ import numpy as np
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import EdgeChain, Point
+from engine.geometry.values import EdgeChain, Point
 
 
 @register

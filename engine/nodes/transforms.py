@@ -7,7 +7,7 @@ import numpy as np
 from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
-from engine.graph.values import Skeleton
+from engine.geometry.values import Skeleton
 
 _DO_COPY = Param("do_copy", "bool", True, doc="keep the input and add the transformed copy")
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..geometry.cancel import report, run_chunked
+from engine.progress import report, run_chunked
 from .kernels import PhasorKernels
 from .sampling import site_cells
 
@@ -91,7 +91,7 @@ def align_phases(kernels: PhasorKernels, *, iterations: int = ITERATIONS, includ
     active : (n,) bool or None; only these sites update, the others keep
         their phases (local re-alignment after a brush stroke)
     progress : callable(done, total) -> bool or None; False cancels
-        (:class:`engine.geometry.cancel.Cancelled`)
+        (:class:`engine.progress.Cancelled`)
 
     Returns
     -------

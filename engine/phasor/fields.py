@@ -5,7 +5,7 @@ direction D (unit vectors), the frequency F (cells per mm) and the angular
 spread Gamma (radians, 0..pi/2).  They live on a low-resolution regular grid
 (the paper uses 64^3) and are sampled trilinearly.
 
-Grid convention (the same as :class:`engine.graph.values.Field`): arrays are
+Grid convention (the same as :class:`engine.geometry.values.Field`): arrays are
 indexed ``[z, y, x]`` with one sample per cell at the cell centre; the box
 corners ``lo, hi`` are in ``(x, y, z)`` order, in mm.  Points outside the
 box take the value at the nearest point inside (clamped), so kernels a

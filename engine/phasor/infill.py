@@ -204,9 +204,11 @@ def slice_noise(infill: PhasorInfill, plane, *, state: str | None = None, engine
     options = dict(fields=infill.fields, filtered=filtered, filter_scale=infill.filter_scale,
                    attenuation=infill.attenuation if filtered else None, progress=progress)
     if engine == "gpu":
-        from engine.gpu import GpuUnavailable, phasor_slice_gpu
+        # looked up on the module at call time (tests replace it: tests/engine/phasor/test_infill.py)
+        from engine.gpu import GpuUnavailable
+        from engine.phasor import gpu_slice
         try:
-            g_v, g_w = phasor_slice_gpu(kernels, plane, out="complex", **options)
+            g_v, g_w = gpu_slice.phasor_slice_gpu(kernels, plane, out="complex", **options)
             return g_v, g_w, "gpu"
         except GpuUnavailable as exc:
             log.warning("GPU slice unavailable, using the numpy evaluator: %s", exc)
@@ -355,9 +357,9 @@ def print_layers(infill: PhasorInfill, *, layer_height: float, pixel: float, eng
     the slice is taken in the middle of the layer.  ``image`` is the black
     diamond cells, ``domain`` the part's section, ``origin`` the centre of
     pixel [0, 0] (x, y mm).  ``progress(done, total)`` is called after each
-    slice; False stops (engine.geometry.cancel.Cancelled).
+    slice; False stops (engine.progress.Cancelled).
     """
-    from engine.geometry.cancel import report
+    from engine.progress import report
 
     zs = layer_positions(infill, layer_height)
     check_pixel(infill.fields, pixel)

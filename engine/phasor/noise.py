@@ -24,7 +24,7 @@ import numpy as np
 
 from numba import njit
 
-from ..geometry.cancel import run_chunked
+from engine.progress import run_chunked
 from .fields import PhasorFields, trilinear
 from .kernels import PhasorKernels
 from .sampling import local_frame

@@ -235,7 +235,7 @@ def pattern_slice(infill, plane: SlicePlane, show: str = "diamonds", *, engine: 
         inf where G vanishes; numpy only)
     engine : "gpu" or "numpy", as :func:`engine.phasor.infill.slice_noise`
     progress : callable(done, total) -> bool or None; False cancels
-        (:class:`engine.geometry.cancel.Cancelled`)
+        (:class:`engine.progress.Cancelled`)
 
     Returns
     -------

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.geometry.cancel import report
+from engine.progress import report
 
 __all__ = ["MAX_VOXELS", "OUTSIDE", "DiamondVolume", "diamond_indicator", "voxel_counts",
            "check_sub_box", "diamond_volume", "diamond_surface"]
@@ -160,7 +160,7 @@ def diamond_volume(infill, lo, hi, *, voxel: float = 0.1, state: str | None = No
     engine : "gpu" (the slice shader; numpy when no EGL context can be made)
         or "numpy"
     progress : callable(done, total) -> bool or None, in nodes evaluated;
-        False cancels (engine.geometry.cancel.Cancelled) within one chunk of
+        False cancels (engine.progress.Cancelled) within one chunk of
         one plane
 
     Returns

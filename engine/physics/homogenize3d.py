@@ -49,7 +49,7 @@ def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
         Called about every 50 ms with ``total = 1000``: setup fills the first
         100, the solve the rest in proportion to the log of the error
         reduction reached. Returning False raises
-        :class:`engine.geometry.cancel.Cancelled`.
+        :class:`engine.progress.Cancelled`.
     threads : int or None
         numba threads for this call. None: one thread for small cells (below
         about 100 000 voxels, ``periodic_fe.AUTO_SERIAL_WORK``: barriers cost
@@ -78,7 +78,7 @@ def homogenize_voxels(density, *, E=1.0, nu=0.45, void_modulus=0.0, tol=1e-8,
         The grid would need more memory than allowed (checked up front).
     RuntimeError
         No convergence within ``max_iterations``.
-    engine.geometry.cancel.Cancelled
+    engine.progress.Cancelled
         ``progress`` returned False.
     """
     E, nu, vm, tol = check_common(E, nu, void_modulus, tol, max_iterations, threads,

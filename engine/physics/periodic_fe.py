@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engine.geometry.cancel import _PARALLEL_LOCK, report
+from engine.progress import PARALLEL_LOCK, report
 from engine.memory import memory_budget
 
 from . import element_kernels as ek
@@ -291,7 +291,7 @@ def _parallel_guard():
         z = np.zeros((2, 1))
         ek.column_dots(z, z, z)
         layer = numba.threading_layer()
-    return _PARALLEL_LOCK if layer == "workqueue" else contextlib.nullcontext()
+    return PARALLEL_LOCK if layer == "workqueue" else contextlib.nullcontext()
 
 
 def _solve(density, dim, E, nu, vm, tol, max_iterations, ticker, t_start, shape_out,

@@ -50,7 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from engine.fileio import write_atomic
-from engine.geometry.cancel import report
+from engine.progress import report
 
 __all__ = ["CompiledStructure", "rescale_pattern", "minimum_relative_thickness", "pattern_wavelength",
            "combine_structures", "infill_signed_distance", "compile_structure", "structure_contours",

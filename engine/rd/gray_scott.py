@@ -51,7 +51,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from engine.geometry.cancel import _PARALLEL_LOCK
+from engine.progress import PARALLEL_LOCK
 
 __all__ = ["RDParams", "TINY", "stability_limit", "default_dt", "resolve_params", "gray_scott_step",
            "operator_rate", "check_fields", "kill_rate", "Stepper"]
@@ -703,6 +703,6 @@ def gray_scott_step(u, v, sigma, *, inside, gamma_map=None, params: RDParams = R
     p = resolve_params(sigma, params)
     stepper = Stepper(sigma, inside, gamma_map, p)
     w = stepper.new_state(u, v)
-    with _PARALLEL_LOCK:            # numba's workqueue layer aborts on concurrent parallel launches
+    with PARALLEL_LOCK:            # numba's workqueue layer aborts on concurrent parallel launches
         stepper.run(w, steps, box)
     return w[0], w[1]

@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from engine.geometry.cancel import _PARALLEL_LOCK, TARGET_CHUNK_SECONDS
+from engine.progress import PARALLEL_LOCK, TARGET_CHUNK_SECONDS, next_chunk
 
 from .diffusion import diffusion_tensors
 from .gray_scott import RDParams, Stepper, check_fields, resolve_params
@@ -337,7 +337,7 @@ def evolve(stepper: Stepper, w, *, inside, step, eps, max_steps, check_every, wi
         raise ValueError("the window contains no cell of the infill space")
     volume = float(np.count_nonzero(inside[sl]) if volume is None else volume)
     if last_check is None:
-        with _PARALLEL_LOCK:
+        with PARALLEL_LOCK:
             last_check = (int(step), stepper.omega_sum(w, window))
     run = _Run(step=int(step), history=list(history), last_check=last_check)
     picker = _ThreadPicker()
@@ -363,7 +363,7 @@ def _loop(stepper, w, run, picker, volume, window, eps, max_steps, check_every, 
         threads, n = picker.choose(n, math.prod(b - a for a, b in reach))
         # None: nothing in reach can ever change
         box = None if active is None else (_grown(active, n, window) if track_empty else window)
-        with _PARALLEL_LOCK:
+        with PARALLEL_LOCK:
             t0 = time.perf_counter()
             if box is not None:
                 stepper.run(w, n, box)
@@ -385,8 +385,8 @@ def _loop(stepper, w, run, picker, volume, window, eps, max_steps, check_every, 
                 run.reason = "converged"
                 return run
         if progress is not None:
-            if elapsed > 0:       # aim at ~TARGET_CHUNK_SECONDS per chunk, changing by <= 4x at a time
-                chunk = max(1, min(check_every, 4 * chunk, int(n * TARGET_CHUNK_SECONDS / elapsed)))
+            if elapsed > 0:       # aim at ~TARGET_CHUNK_SECONDS per chunk, growing by <= 4x at a time
+                chunk = next_chunk(chunk, n, elapsed, most=check_every)
             now = time.perf_counter()
             if now - t_report >= TARGET_CHUNK_SECONDS or run.step >= max_steps:
                 t_report = now

@@ -12,7 +12,7 @@ and used from a notebook:
 * a brush drag turned into stamp centres no further apart than half the
   brush radius (`stroke_centres`), so that a fast drag leaves no gaps.
 
-Conventions (shared with ``engine.graph.values``): grids are indexed
+Conventions (shared with ``engine.rd.values``): grids are indexed
 ``[y, x]`` or ``[z, y, x]``; vector and rotation components are ordered
 ``(x, y[, z])``; a point ``(x, y[, z])`` in cell units lies in cell
 ``[floor(y), floor(x)]``, cell centres sit at half-integers. A slice normal

@@ -44,7 +44,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from engine.geometry.cancel import report
+from engine.progress import report
 
 __all__ = ["Regularised", "mask_trivial_directions", "complete_partial_orientations",
            "regenerate_trivial_orientations", "regularise_orientations", "closest_matrix",
@@ -294,7 +294,7 @@ def regenerate_trivial_orientations(rotation, *, neighbourhood="face", max_steps
         vectorised sweep (see the module notes).
     progress : callable(done, total) -> bool, optional
         ``done`` counts filled cells out of the zero cells at the start;
-        returning False raises :class:`engine.geometry.cancel.Cancelled`.
+        returning False raises :class:`engine.progress.Cancelled`.
 
     Returns
     -------

@@ -22,7 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from engine.geometry.cancel import run_chunked
+from engine.progress import run_chunked
 
 __all__ = ["PrincipalStresses", "principal_decomposition", "check_tensor_field",
            "reconstruct_tensor", "format_cell", "SYMMETRY_WARN", "SYMMETRY_REFUSE"]
@@ -131,7 +131,7 @@ def principal_decomposition(sigma, *, progress=None):
         symmetrised with a warning, gross asymmetry refused).
     progress : callable(done, total) -> bool, optional
         Called between chunks of cells; returning False raises
-        :class:`engine.geometry.cancel.Cancelled`.
+        :class:`engine.progress.Cancelled`.
 
     Returns
     -------

@@ -42,7 +42,7 @@ def optimise(problem, *, progress=None, **options):
     ----------
     problem : Problem
     progress : callable(done, total) -> bool, optional; ``False`` cancels
-        (raises :class:`engine.geometry.cancel.Cancelled`).
+        (raises :class:`engine.progress.Cancelled`).
     **options : keyword options of :func:`simp_compliance`,
         :func:`stress_aware_simp` or :func:`orthotropic_orientation`.
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.geometry.cancel import report
+from engine.progress import report
 
 from .assembly import grid_fe
 from .design import TopOptResult, design_space

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.geometry.cancel import report
+from engine.progress import report
 
 from .assembly import grid_fe
 from .design import TopOptResult, design_space
@@ -120,7 +120,7 @@ def simp_compliance(problem, *, max_iter=200, tol=0.01, move=0.2, ftol=None, x0=
         Starting design (default: uniform at the volume fraction).
     progress : callable(done, total) -> bool, optional
         Called once per iteration; ``False`` raises
-        :class:`engine.geometry.cancel.Cancelled`.
+        :class:`engine.progress.Cancelled`.
 
     Returns
     -------

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from app.autosave import ENV_VAR, AutosaveManager, default_autosave_dir, pid_alive
+from engine.autosave import ENV_VAR, AutosaveManager, default_autosave_dir, pid_alive
 from engine.graph import GraphDocument, SetSeed, UndoStack, document_to_dict, save_project
 
 
@@ -118,7 +118,7 @@ def test_missing_directory_finds_nothing(tmp_path):
 
 
 def test_autosave_module_does_not_import_qt():
-    code = "import sys, app.autosave; sys.exit('PySide6' in sys.modules)"
+    code = "import sys, engine.autosave; sys.exit('PySide6' in sys.modules)"
     root = Path(__file__).resolve().parents[2]
     assert subprocess.run([sys.executable, "-c", code], cwd=root).returncode == 0
 

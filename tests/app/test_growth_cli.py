@@ -7,6 +7,7 @@ import pytest
 
 from app import cli
 from engine.batch import read_study
+from engine.graph.node import node_seed
 from engine.growth import grow_tiling, load_tileset, load_tiling, tiling_image
 
 
@@ -24,10 +25,13 @@ def test_grow_writes_the_tiling_and_its_image(tmp_path, capsys):
     assert code == 0, err
     info = json.loads(stdout)
     ts = load_tileset("TL+-")
-    ref = grow_tiling(ts, (9, 12), periodic=True, rng=7,
+    # --seed is the document seed: the Grow node (id grow1) derives the tiling seed from it
+    seed = node_seed(7, "grow1")
+    ref = grow_tiling(ts, (9, 12), periodic=True, rng=seed,
                       hints={"T": 1, "L": 1, "+": 2, "-": 1})
     til = load_tiling(out)
-    assert np.array_equal(til.tiles, ref.tiles) and til.periodic and til.seed == 7
+    assert np.array_equal(til.tiles, ref.tiles) and til.periodic and til.seed == seed
+    assert info["seed"] == 7 and info["tiling_seed"] == seed
     assert info["n_defects"] == ref.n_defects and info["shape"] == [9, 12]
     assert sum(info["realised_probabilities"].values()) == pytest.approx(1.0)
     img = np.asarray(Image.open(png))
@@ -42,17 +46,47 @@ def test_grow_3d_and_text_output(tmp_path, capsys):
     assert "defects" in stdout and load_tiling(tmp_path / "c.json").shape == (2, 3, 3)
 
 
+def test_grow_defaults_are_the_node_defaults_and_tiling_seed_is_used_as_is(tmp_path, capsys):
+    """Periodic is on unless --no-periodic (the node's default); --tiling-seed
+    sets the Grow node's seed parameter, the tiling seed used as is."""
+    ts = load_tileset("TL+-")
+    code, stdout, err = _run(capsys, "grow", "TL+-", "--size", "5x4", "--tiling-seed", 7,
+                             "--out", tmp_path / "a.json", "--json")
+    assert code == 0, err
+    til = load_tiling(tmp_path / "a.json")
+    assert til.periodic and til.seed == 7
+    assert np.array_equal(til.tiles, grow_tiling(ts, (4, 5), periodic=True, rng=7).tiles)
+    code, stdout, err = _run(capsys, "grow", "TL+-", "--size", "5x4", "--no-periodic",
+                             "--out", tmp_path / "b.json", "--json")
+    assert code == 0, err
+    assert not load_tiling(tmp_path / "b.json").periodic and not json.loads(stdout)["periodic"]
+
+
+def test_grow_help_shows_the_schema(capsys):
+    try:
+        assert cli.main(["grow", "--help"]) in (0, None)
+    except SystemExit as exc:
+        assert exc.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "allowed: integers in [1, 1000]" in text and "blocks" in text
+    assert "allowed: a finite number in [0, 1e+06]" in text and "--no-periodic" in text
+
+
 @pytest.mark.parametrize("args, match", [
     (["grow", "nope", "--size", "4x4"], "TILESET 'nope'"),
-    (["grow", "TL+-", "--size", "0x4"], "--size '0x4': every count must be in [1, 1000]"),
-    (["grow", "TL+-", "--size", "4x4x4"], "--size '4x4x4': the tile set is 2D"),
-    (["grow", "TL+-", "--size", "4by4"], "--size '4by4'"),
+    (["grow", "TL+-", "--size", "0x4"], "--size 0x4: out of range (allowed: integers in [1, 1000])"),
+    (["grow", "TL+-", "--size", "4x4x4"], "--size 4x4x4: the tile set is 2D"),
+    (["grow", "TL+-", "--size", "4by4"], "--size 4by4"),
+    (["grow", "TL+-", "--size", "2000x1000"], "--size 2000x1000: out of range"),
+    (["grow", "TL+-", "--size", "1000x999x2"], "--size 1000x999x2: the tile set is 2D"),
+    (["grow", "TL+-", "--size", "4x4", "--tiling-seed", "-2"], "--tiling-seed -2: out of range"),
     (["grow", "TL+-", "--size", "4x4", "--hints", "T=1,X=2"], "--hints: hints entry 2 'X=2'"),
     (["grow", "TL+-", "--size", "4x4", "--availability", "-1"], "--availability -1"),
     (["grow", "cubic-beams", "--size", "2x2x2", "--png", "x.png"], "--png"),
     (["study", "TL+-", "--n", "0"], "--n 0"),
     (["study", "TL+-", "--hints", "T=x"], "weight 'x' is not a number"),
-    (["study", "TL+-", "--size", "3x0"], "--size '3x0'"),
+    (["study", "TL+-", "--size", "3x0"], "--size 3x0"),
+    (["study", "TL+-", "--nu", "0.5"], "--nu 0.5: out of range (allowed: a finite number in [-0.999, 0.499])"),
     (["study", "TL+-", "--size", "3x3", "--n", "1", "--out", "s.txt",
       "--scheduler", "synchronous"], "--out s.txt: unsupported extension '.txt' (allowed: a file "
                                       "ending in .csv, .parquet)"),

@@ -194,3 +194,16 @@ def test_printability_text_is_a_table(project, capsys):
     rows = [line.split() for line in lines[4:]]
     assert all(r[1] == ".." for r in rows)
     assert sum(int(r[3]) for r in rows) == oh and sum(int(r[4]) for r in rows) == ov
+
+
+def test_memory_is_checked_before_the_fields_are_evaluated(project, tmp_path, capsys, monkeypatch):
+    from engine.nodes.phasor import PhasorFieldsNode
+
+    path, _ = project
+    monkeypatch.setenv("MESOFORGE_MEMORY_LIMIT", "1M")
+    monkeypatch.setattr(PhasorFieldsNode, "evaluate", lambda *a, **k: pytest.fail("evaluated before refusing"))
+    code, _, err = _run(capsys, path, "--slice", "z=0.5", "--png", tmp_path / "a.png", "--px", 0.002)
+    assert code == 2 and "--px 0.002" in err and "needs about" in err
+    code, _, err = _run(capsys, path, "--gcode", tmp_path / "a.gcode", "--layer", 1e-4)
+    assert code == 2 and "--layer 0.0001" in err and "needs about" in err
+    assert not (tmp_path / "a.png").exists() and not (tmp_path / "a.gcode").exists()

@@ -32,7 +32,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from engine.gpu import SlicePlane, gpu_context, phasor_slice_gpu  # noqa: E402
+from engine.gpu import SlicePlane, gpu_context  # noqa: E402
+from engine.phasor.gpu_slice import phasor_slice_gpu  # noqa: E402
 from engine.phasor.attenuation import attenuation_grid  # noqa: E402
 from engine.phasor.fields import constant_fields  # noqa: E402
 from engine.phasor.noise import phasor_complex, phasor_complex_reference  # noqa: E402

@@ -403,7 +403,7 @@ def test_a_d_stroke_records_heading_and_tilt_and_draws_glyphs(qtbot, make_panel)
 def test_a_slow_slice_shows_progress_and_can_be_cancelled(qtbot, make_panel):
     import time
 
-    from engine.geometry.cancel import report
+    from engine.progress import report
 
     from ui.phasor_worker import SliceJob
 

@@ -13,7 +13,7 @@ from PySide6 import QtCore
 
 from engine.graph import (AddNode, Connect, Evaluator, GraphDocument, SetParam, UndoStack,
                           document_to_dict)
-from engine.graph.values import TilingValue
+from engine.growth.values import TilingValue
 from engine.growth import UNASSIGNED, grow_tiling, load_tileset, regrow_region
 from engine.growth.regions import parse_region_map
 from engine.growth.regrow import dilate

@@ -124,7 +124,7 @@ def test_a_failing_conjugate_surface_shows_the_error_naming_the_vertex(window, w
 
 
 def test_what_slides_follows_the_solver_and_the_report():
-    from engine.graph.values import SurfaceReport
+    from engine.geometry.surfaces.values import SurfaceReport
     from ui.surface_panel import error_vertex, sliding_segments
 
     segment_chain = [0, 0, 1, 1, 2]

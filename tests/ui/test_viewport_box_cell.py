@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from engine.graph.values import Solid
+from engine.geometry.values import Solid
 from engine.geometry.marching import periodic_mesh
 from engine.geometry.sdf_lines import line_sdf_grid
 from ui.viewport import Viewport, block_bounds, sphere_placement, tile_offsets

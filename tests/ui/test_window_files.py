@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from app.autosave import AutosaveManager
+from engine.autosave import AutosaveManager
 from engine.graph import AddNode, Connect, SetParam, SetSeed, document_to_dict, load_project
 from engine.growth.regions import format_region_map
 from ui.main_window import EXAMPLES_DIR

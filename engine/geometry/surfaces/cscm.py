@@ -57,7 +57,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.sparse.linalg import splu
 
-from ..cancel import report
+from engine.progress import report
 from .conjugate import conjugate_surface
 from .cscm_starts import choose_run, search_starts
 from .curvature import cotan_laplacian, surface_area, surface_report
@@ -451,7 +451,7 @@ def conjugate_surface_construction(fbv, loop_points, *, energy="auto", max_iter=
         ``progress(done, total) -> bool``, called per energy evaluation
         (``total`` estimates two per Nelder-Mead iteration and start) and
         per Plateau step; False cancels
-        (:class:`~engine.geometry.cancel.Cancelled`).
+        (:class:`~engine.progress.Cancelled`).
 
     Returns
     -------

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from ..cancel import report
+from engine.progress import report
 from .boundary import BoundaryLoop, sample_loop
 from .curvature import cotan_laplacian, face_areas, mixed_areas, surface_report
 from .mesh_init import delaunay_flips, disc_mesh
@@ -163,7 +163,7 @@ def solve_mixed_minimal(loop, *, edge_length=None, time_step=0.05, tol=1e-7, max
     ValueError
         Not a BoundaryLoop, no fixed segment (a fully sliding loop needs the
         conjugate solver), or bad options.
-    engine.geometry.cancel.Cancelled
+    engine.progress.Cancelled
         The progress callback returned False.
     """
     if not isinstance(loop, BoundaryLoop):

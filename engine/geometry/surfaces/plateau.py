@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from ..cancel import report
+from engine.progress import report
 from .curvature import cotan_laplacian, face_areas
 from .mesh_init import delaunay_flips, disc_mesh, midpoint_subdivide
 
@@ -159,7 +159,7 @@ def relax_plateau(vertices, faces, boundary, *, tol=1e-10, max_iter=DEFAULT_MAX_
         Anderson memory (0 for plain steps).
     progress : callable, optional
         ``progress(done, total) -> bool``; False cancels
-        (:class:`~engine.geometry.cancel.Cancelled`). Called once per step.
+        (:class:`~engine.progress.Cancelled`). Called once per step.
     progress_offset, progress_total : int
         Where these steps sit in a longer run (for multi-level solves).
 
@@ -257,7 +257,7 @@ def solve_plateau(boundary_points, *, edge_length=None, levels=1, tol=1e-10,
     ValueError
         Bad polygon (fewer than 3 vertices, NaN, repeated consecutive
         vertices) or options.
-    engine.geometry.cancel.Cancelled
+    engine.progress.Cancelled
         The progress callback returned False.
     """
     _check_options(edge_length, levels, tol, max_iter)

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 from scipy.linalg import cholesky, solve_triangular
 from scipy.optimize import minimize
 
-from ..cancel import report
+from engine.progress import report
 from .boundary import BoundaryLoop, sample_loop
 from .curvature import cotan_laplacian, mixed_areas
 from .mesh_init import _interior_edges, disc_mesh
@@ -336,7 +336,7 @@ def solve_thin_shell(boundary, *, alpha=DEFAULT_ALPHA, edge_length=None,
     ValueError
         Bad boundary (see :func:`~.boundary.boundary_loop` and
         :func:`~.mesh_init.disc_mesh`) or options.
-    engine.geometry.cancel.Cancelled
+    engine.progress.Cancelled
         The progress callback returned False.
     """
     _check_options(alpha, rest_scale, tol, max_iter, edge_length)

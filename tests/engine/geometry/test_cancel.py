@@ -3,7 +3,7 @@
 import pytest
 
 from engine.geometry import Cancelled
-from engine.geometry.cancel import report, run_chunked
+from engine.progress import report, run_chunked
 
 
 def test_report_semantics():

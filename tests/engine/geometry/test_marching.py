@@ -161,7 +161,7 @@ def test_slab_meshing_equals_one_marching_cubes_call_and_cancels():
     # on the whole padded grid (compared as sets of triangles by coordinates).
     from skimage.measure import marching_cubes
     from engine.geometry import marching
-    from engine.geometry.cancel import Cancelled
+    from engine.progress import Cancelled
 
     rng = np.random.default_rng(5)
     field = np.asarray(rng.normal(size=(60, 20, 20)), np.float32)

@@ -8,7 +8,7 @@ import pyvista as pv
 import trimesh
 from PIL import Image
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.mesh_io import export_mesh
 from engine.geometry.voxel_inputs import (
     GridTooLarge, available_memory_bytes, check_memory, load_voxel_grid, memory_estimate_bytes,

@@ -8,9 +8,10 @@ import threading
 import numpy as np
 import pytest
 
-import engine.gpu.phasor_slice as ps
-from engine.geometry.cancel import Cancelled
-from engine.gpu import SlicePlane, diamond_mask, phasor_slice_gpu, sawtooth
+import engine.phasor.gpu_slice as ps
+from engine.progress import Cancelled
+from engine.gpu import SlicePlane
+from engine.phasor.gpu_slice import diamond_mask, phasor_slice_gpu, sawtooth
 from engine.phasor.attenuation import attenuation_grid
 from engine.phasor.fields import PhasorFields, constant_fields, trilinear
 from engine.phasor.kernels import PhasorKernels

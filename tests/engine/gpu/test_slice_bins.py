@@ -4,7 +4,7 @@ reach is listed for the pixel's bin (checked against all pairs)."""
 import numpy as np
 import pytest
 
-from engine.gpu._slice_bins import bin_lists, project_kernels, tile_members
+from engine.phasor._slice_bins import bin_lists, project_kernels, tile_members
 from engine.gpu.slice_plane import SlicePlane
 
 from .test_phasor_slice import PLANES, random_kernels

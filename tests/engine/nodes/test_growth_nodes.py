@@ -7,7 +7,9 @@ import trimesh
 import engine.nodes.growth  # noqa: F401  (registers the nodes)
 from engine.graph import (AddNode, Connect, Evaluator, GraphDocument, ParamError, SetParam,
                           SetSeed, UndoStack)
-from engine.graph.values import Field, Skeleton, Stiffness, TilingValue
+from engine.geometry.values import Field, Skeleton
+from engine.growth.values import TilingValue
+from engine.physics.values import Stiffness
 from engine.growth import grow_tiling, load_tileset, realised_probabilities, tiling_image
 
 

@@ -171,7 +171,7 @@ def test_zero_length_line_is_a_sphere():
 def test_object_thickens_many_surfaces_in_one_pass_exactly_as_their_union():
     from engine.geometry.csg import csg_reduce
     from engine.geometry.sdf_triangles import surface_sdf_grid
-    from engine.graph.values import Skeleton, SurfaceElement
+    from engine.geometry.values import Skeleton, SurfaceElement
     from engine.nodes.solids import ObjectNode
 
     rng = np.random.default_rng(5)

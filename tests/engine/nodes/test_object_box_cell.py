@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from app.evaluation import tiled_mesh
+from engine.tiled_mesh import tiled_mesh
 from engine.geometry.marching import boundary_section_match
 from engine.graph import AddNode, Connect, Evaluator, GraphDocument, ParamError, SetParam, UndoStack
 from engine.graph.project import document_from_dict, document_to_dict

@@ -6,7 +6,7 @@ import pytest
 import trimesh
 
 from engine.graph import AddNode, Connect, Evaluator, GraphDocument, SetParam, UndoStack
-from engine.graph.values import Solid
+from engine.geometry.values import Solid
 from engine.phasor.volume import diamond_surface, diamond_volume
 
 

@@ -8,7 +8,9 @@ from scipy.ndimage import distance_transform_edt
 
 from engine.graph import (AddNode, Connect, Evaluator, GraphDocument, ParamError, SetParam, SetSeed,
                           UndoStack, load_project, save_project)
-from engine.graph.values import ContourValue, DesignValue, Field, RDFieldsValue, RDStructuresValue, Solid
+from engine.geometry.values import Field, Solid
+from engine.rd.values import ContourValue, RDFieldsValue, RDStructuresValue
+from engine.topopt.values import DesignValue
 
 # small enough for a few seconds: gamma = 4 halves the pattern's wavelength so
 # that stripes form in the thin members of a 32 x 16 design grown on 96 x 48

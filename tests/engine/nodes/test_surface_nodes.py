@@ -11,7 +11,7 @@ from engine.geometry.surfaces.curvature import surface_area
 from engine.geometry.surfaces.mesh_init import boundary_loop_of
 from engine.graph import AddNode, Connect, Evaluator, GraphDocument, SetParam, UndoStack
 from engine.graph.errors import ParamError
-from engine.graph.values import SurfaceReport
+from engine.geometry.surfaces.values import SurfaceReport
 
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.phasor.align import align_phases, alignment_step_reference
 from engine.phasor.fields import PhasorFields, constant_fields
 from engine.phasor.sampling import sample_kernels

@@ -7,7 +7,7 @@ import pytest
 import trimesh
 
 from engine.fab import PrintSettings, read_gcode_paths
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.phasor.domain import box_of, slice_domain
 from engine.phasor.field_init import fields_from_spec
 from engine.phasor.fields import constant_fields
@@ -86,13 +86,13 @@ def test_energy_matches_the_singularity_module(boxed):
 
 
 def test_gpu_falls_back_to_numpy_when_egl_is_missing(boxed, monkeypatch, caplog):
-    import engine.gpu
+    import engine.phasor.gpu_slice
     from engine.gpu import GpuUnavailable
 
     def no_gpu(*args, **kwargs):
         raise GpuUnavailable("no EGL here")
 
-    monkeypatch.setattr(engine.gpu, "phasor_slice_gpu", no_gpu)
+    monkeypatch.setattr(engine.phasor.gpu_slice, "phasor_slice_gpu", no_gpu)
     with caplog.at_level(logging.WARNING, logger="engine.phasor.infill"):
         r = infill_slice(boxed, "z", 0.5, 0.1, engine="gpu")
     assert r.engine == "numpy" and "no EGL here" in caplog.text

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.phasor.align import align_phases
 from engine.phasor.fields import PhasorFields, constant_fields
 from engine.phasor.kernels import PhasorKernels

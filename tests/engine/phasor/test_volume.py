@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.marching import mesh_volume
 from engine.phasor.fields import constant_fields
 from engine.phasor.infill import sample_infill

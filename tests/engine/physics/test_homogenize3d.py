@@ -14,7 +14,7 @@ import numpy as np
 from engine.geometry.lattices import octet_segments as _octet_segments
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.physics import periodic_fe
 from engine.physics.homogenize3d import homogenize_voxels
 from engine.physics.reference_solvers import homogenize_direct

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.rd.regularise import (V_ALPHA, V_BETA, closest_matrix, complete_partial_orientations,
                                   mask_trivial_directions, orthonormalise, regenerate_trivial_orientations,
                                   regularise_orientations, signed_permutations)

@@ -5,7 +5,7 @@ import warnings
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.rd.tensor_field import check_tensor_field, principal_decomposition, reconstruct_tensor
 
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.topopt import preset, simp_compliance
 from engine.topopt.assembly import grid_fe
 from engine.topopt.design import design_space

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from skimage.measure import marching_cubes, mesh_surface_area
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.surfaces.cscm import conjugate_surface_construction
 from engine.geometry.surfaces.curvature import surface_area, surface_report
 from engine.geometry.surfaces.fbv import FBVError, cuboid, tetrahedron, triangular_prism

@@ -4,7 +4,7 @@ a flat strip and Scherk's first surface."""
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.surfaces.boundary import boundary_loop, loop_from_chains
 from engine.geometry.surfaces.mixed_minimal import solve_mixed_minimal
 

@@ -6,7 +6,7 @@ import time
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.surfaces.curvature import surface_report
 from engine.geometry.surfaces.plateau import richardson_area, solve_plateau
 

@@ -5,7 +5,7 @@ effect of the bending weight."""
 import numpy as np
 import pytest
 
-from engine.geometry.cancel import Cancelled
+from engine.progress import Cancelled
 from engine.geometry.surfaces.boundary import boundary_loop
 from engine.geometry.surfaces.mesh_init import disc_mesh
 from engine.geometry.surfaces.thin_shell import shell_energy, shell_model, solve_thin_shell

@@ -1,4 +1,4 @@
-"""Autosave and crash recovery.  Pure Python: no Qt here.
+"""Autosave and crash recovery of a project document.  Pure Python: no Qt here.
 
 Each running window owns one `AutosaveManager`.  `save` writes the document
 to ``<session>.json`` in the autosave folder and a small sidecar

@@ -12,7 +12,7 @@ How the work is laid out
 ------------------------
 The slice is done in tiles (default 256 x 256 pixels), with progress and
 cancel between them.  For each tile the kernels whose reach sphere meets
-it are projected on the plane (float64, :mod:`engine.gpu._slice_bins`) and
+it are projected on the plane (float64, :mod:`engine.phasor._slice_bins`) and
 listed per ``bin x bin`` pixel square; a compute-shader work group is one
 square and loops over its list.  This differs from the textbook fragment
 shader that walks the 3D cells around each pixel, for two reasons measured
@@ -65,13 +65,14 @@ import threading
 
 import numpy as np
 
-from engine.geometry.cancel import report
-from engine.gpu._phasor_glsl import compute_source
-from engine.gpu._slice_bins import bin_lists, plane_basis, project_kernels, tile_members
 from engine.gpu.context import gpu_session
 from engine.gpu.slice_plane import SlicePlane
-from engine.phasor.kernels import PhasorKernels
-from engine.phasor.sampling import VERTICAL_EPS
+from engine.progress import report
+
+from ._gpu_slice_glsl import compute_source
+from ._slice_bins import bin_lists, plane_basis, project_kernels, tile_members
+from .kernels import PhasorKernels
+from .sampling import VERTICAL_EPS
 
 DEFAULT_TILE = 256  # pixels per tile side: ~0.1 s per tile filtered on llvmpipe
 # Pixels of a row per shader invocation, unfiltered / filtered: each kernel
@@ -227,7 +228,7 @@ def phasor_slice_gpu(kernels, plane, *, fields=None, filtered=False, filter_scal
         chunk of kernels) and one progress report per tile.
     progress : callable ``progress(done, total) -> bool``, optional
         Called before the first tile and after each; returning ``False``
-        raises :class:`engine.geometry.cancel.Cancelled`.
+        raises :class:`engine.progress.Cancelled`.
 
     Returns
     -------

@@ -1,10 +1,10 @@
 """GLSL source of the phasor-slice compute shader (kept in Python: no package data).
 
 One work group is one ``BIN x BIN`` pixel square of a tile; it loops over
-that bin's list of kernels (see :mod:`engine.gpu._slice_bins`).  The loop
+that bin's list of kernels (see :mod:`engine.phasor._slice_bins`).  The loop
 bounds and list entries are the same for the whole group, so the driver
 can load the kernel data once per SIMD batch instead of per pixel.  The
-buffer layout is described in :mod:`engine.gpu.phasor_slice`.
+buffer layout is described in :mod:`engine.phasor.gpu_slice`.
 :func:`compute_source` unrolls the per-pixel code; the caller prepends
 ``#version 430`` and the defines BIN, PIX, GROUP_X (= BIN / PIX), CAPACITY,
 FRAME_EPS and, for the filtered kernels (eq. 14-16), FILTERED.
