@@ -71,6 +71,12 @@ class EvalWorker(QtCore.QObject):
             self.superseded = True
         self.runner.submit(lambda task: self._evaluate(task, snapshot), data=tag, supersede=True)
 
+    def adopt(self, snapshot: GraphSnapshot, node_id: str, outputs: dict, inputs: dict | None = None) -> None:
+        """Offer ``outputs`` as node ``node_id``'s result for ``snapshot`` (a dock's finished live run):
+        the evaluator checks and stores it in the worker thread when the next evaluation starts,
+        never during a running one (`Evaluator.queue_adoption`).  Returns at once."""
+        self.evaluator.queue_adoption(snapshot, node_id, outputs, inputs=inputs)
+
     def cancel(self) -> None:
         """Stop the running evaluation and drop any queued one."""
         self.superseded = False

@@ -14,7 +14,9 @@ class LiveGrowthBox(QtWidgets.QGroupBox):
 
     ``session_factory()`` (set by the owner) returns the RDGrowNode's
     `RDGrowthSession` to run, None when there is none, or raises ValueError
-    saying why the node refuses.
+    saying why the node refuses.  ``adopt_result(node_id, outputs, inputs)``
+    (set by the owner: the window's, `ui.window_evaluation`; or None) takes a
+    finished growth as the node's result (`adopt`).
 
     Signals
     -------
@@ -30,6 +32,7 @@ class LiveGrowthBox(QtWidgets.QGroupBox):
     def __init__(self, parent=None):
         super().__init__("Live growth", parent)
         self.session_factory = None
+        self.adopt_result = None
         self.worker = LiveGrowthWorker(self)
         self.worker.frame.connect(self._on_frame)
         self.worker.stopped.connect(self._on_stopped)
@@ -43,8 +46,9 @@ class LiveGrowthBox(QtWidgets.QGroupBox):
         self.cancel_button = QtWidgets.QPushButton("Cancel")
         self.cancel_button.clicked.connect(self.cancel)
         self.apply_button = QtWidgets.QPushButton("Apply")
-        self.apply_button.setToolTip("evaluate the document: the RDGrow node grows the same structure "
-                                     "the normal way (the live run never changes the document)")
+        self.apply_button.setToolTip("evaluate the document; a growth run to the end with the node's "
+                                     "parameters is taken as the RDGrow node's result, so only what "
+                                     "follows it evaluates (the live run never changes the document)")
         self.apply_button.clicked.connect(self.apply)
         for b in (self.grow_button, self.pause_button, self.cancel_button, self.apply_button):
             row.addWidget(b)
@@ -97,6 +101,25 @@ class LiveGrowthBox(QtWidgets.QGroupBox):
 
     def apply(self) -> None:
         self.apply_requested.emit()
+
+    def finished_value(self, params: dict, seed: int):
+        """The RDGrow node's value (brush edits applied) of a growth run to the end with the
+        node parameters ``params`` and node seed ``seed``; None for any other growth."""
+        w, session = self.worker, self.worker.session
+        if session is None or w.status != "done" or session.value is None:
+            return None
+        return session.value if session.params == dict(params) and session.seed == int(seed) else None
+
+    def adopt(self, grow, doc) -> bool:
+        """Hand the growth to ``adopt_result`` as RDGrow node ``grow``'s result in ``doc`` when it ran
+        to the end with the node's parameters and seed now, with the fields it grew from (the
+        evaluator takes it only if they are its cached input of the node).  False when not handed."""
+        from engine.graph.node import node_seed
+
+        value = None if grow is None else self.finished_value(grow.params, node_seed(doc.seed, grow.id))
+        if value is None or self.adopt_result is None:
+            return False
+        return bool(self.adopt_result(grow.id, {"structures": value}, {"rdfields": value.fields.source_of()}))
 
     def _on_pause_clicked(self) -> None:
         if self.worker.is_running:

@@ -17,8 +17,10 @@ on a 2D grid or one slice of a 3D grid (axis and a scrub slider):
 (`ui.rd_worker`), drawing every N steps with the step count and ``G^t``;
 Pause / Resume continue exactly, Cancel keeps the last complete step.
 The live run never changes the document; "Apply" asks the window to
-evaluate the document the normal way (signal ``evaluate_requested``), and
-the node grows the same bytes.
+evaluate it (signal ``evaluate_requested``), first handing a growth run to
+the end with the node's current parameters, seed and input to the window's
+evaluator as the node's result (`LiveGrowthBox.adopt`, `Evaluator.adopt`):
+RDGrow is then "cached" and only RDCompile evaluates.
 
 A left drag on the picture is one brush stroke (Escape abandons it): erase
 or draw appends ONE edit ``{mode, centres, radius}`` in growth-grid cells
@@ -61,6 +63,7 @@ class RDPanel(QtWidgets.QWidget):
     Parameters
     ----------
     doc : GraphDocument; undo : UndoStack over it (strokes are pushed there)
+    parent : the main window (it sets ``live_box.adopt_result`` to its ``adopt_result``, `ui.window_evaluation`)
 
     Signals
     -------
@@ -338,8 +341,6 @@ class RDPanel(QtWidgets.QWidget):
         """Why painting is off now, or None when it is on."""
         return self.brush_tool.paint_block_reason()
 
-
-
     def redraw(self) -> None:
         """Draw the current view, slice and comparison from the data held."""
         if self.canvas.in_stroke:
@@ -426,10 +427,12 @@ class RDPanel(QtWidgets.QWidget):
         self.live_box.cancel()
 
     def _on_apply(self) -> None:
-        """The node's evaluation is the truth: drop the live picture, ask for an evaluation."""
+        """Drop the live picture, hand over a finished growth (`LiveGrowthBox.adopt`), evaluate."""
         self.live = None
         self.redraw()
-        self.message.setText("evaluating the document: the RDGrow node's result replaces the live view")
+        self.message.setText("evaluating: the live growth is offered as the RDGrow node's result"
+                             if self.live_box.adopt(self.node_of("RDGrow"), self.doc) else
+                             "evaluating the document: the RDGrow node's result replaces the live view")
         self.evaluate_requested.emit()
 
     def _on_live_frame(self, frame) -> None:

@@ -13,7 +13,9 @@ never piles up a backlog):
 * ``cancel()`` stops the same way and ends the run, keeping the last
   complete step on screen;
 * the run ends by itself once every direction converged (G^t < eps) or
-  reached ``max_steps``.
+  reached ``max_steps``; the node's value (`RDGrowthSession.apply`: the
+  brush edits applied by local regrowth) is then made in the same thread,
+  so the dock can hand it to the window's evaluator without regrowing.
 
 The document is never touched here.
 """
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore
 
+from engine.graph.errors import NodeInputError
 from engine.nodes.rd_session import RDGrowthFrame, RDGrowthSession
 
 from .task_runner import Task, TaskRunner
@@ -109,6 +112,10 @@ class LiveGrowthWorker(QtCore.QObject):
         def grow(task: Task):
             while not session.advance(every, task.progress):   # Cancelled when paused or cancelled
                 task.publish(session.frame("running"))
+            try:
+                session.apply(task.progress)   # kept as session.value; Cancelled like the growth
+            except NodeInputError:
+                pass   # an edit the node refuses: the evaluation reports it (session.value stays None)
             return session.frame("done")
 
         self._stop_as = "cancelled"

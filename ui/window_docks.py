@@ -50,6 +50,7 @@ class WindowDocks:
         self.rd_dock = self._dock("Reaction Diffusion", self.rd_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.rd_dock)
         self.rd_panel.evaluate_requested.connect(self.evaluate_now)
+        self.rd_panel.live_box.adopt_result = self.adopt_result     # Apply hands a finished live growth over
         self.study_panel = StudyPanel(self)
         self.study_dock = self._dock("Studies", self.study_panel, QtCore.Qt.DockWidgetArea.RightDockWidgetArea)
         self.tabifyDockWidget(self.inspector_dock, self.study_dock)

@@ -36,6 +36,17 @@ class WindowEvaluation:
         self._eval_total = len(snapshot.nodes)
         self.worker.request(snapshot, tag=self._generation)
 
+    def adopt_result(self, node_id: str, outputs: dict, inputs: dict | None = None) -> bool:
+        """Offer ``outputs`` as node ``node_id``'s result for the document as it is now (the RD
+        dock's finished live growth); the next evaluation serves it cached if the evaluator
+        accepts it (`EvalWorker.adopt`).  False when the document cannot be snapshotted."""
+        try:
+            snapshot = self.doc.snapshot()
+        except Exception:
+            return False
+        self.worker.adopt(snapshot, node_id, outputs, inputs)
+        return True
+
     def cancel_evaluation(self) -> None:
         self._debounce.stop()
         if self.worker.is_busy:

@@ -12,6 +12,12 @@ next evaluation hands them as ``ctx.previous``.  `export_state` encodes those
 results for the project file and `import_state` takes them back: a stored
 result whose key equals the node's key now is used as the node's output (no
 re-evaluation); one whose key differs is still offered as ``ctx.previous``.
+
+A result computed outside an evaluation (a dock's live run of the node's own
+session) can be `adopt`-ed: stored under the key evaluation would compute for
+that snapshot, as if the node had evaluated, so the next evaluation serves it
+as cached and only what is downstream runs.  `queue_adoption` defers that to
+the start of the next evaluation, on the evaluating thread.
 """
 
 from __future__ import annotations
@@ -88,6 +94,9 @@ def _canonical(obj: Any) -> str:
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
+_Missing = object()  # an upstream result without the port an edge names
+
+
 @dataclass
 class _Held:
     """A stateful node's last result (what ``ctx.previous`` is built from)."""
@@ -123,6 +132,39 @@ def check_required_inputs(snapshot: GraphSnapshot, node_id: str,
                              f"({port.type}) is not connected", node=node_id, where=port.name)
 
 
+def _checked(snapshot: GraphSnapshot, node_id: str,
+             incoming: dict[str, dict[str, list[Edge]]]) -> tuple[type, dict]:
+    """(node type class, validated parameters) of ``node_id``; GraphError for a
+    refused parameter or a missing required input, KeyError for an unknown type."""
+    type_name, params = snapshot.nodes[node_id]
+    cls = node_type(type_name)
+    params = cls.validate_params(params, node_id)
+    check_required_inputs(snapshot, node_id, incoming)
+    return cls, params
+
+
+def _cache_key(snapshot: GraphSnapshot, node_id: str, cls: type, params: dict,
+               ports: dict[str, list[Edge]], keys: dict[str, str]) -> tuple[dict[str, list[Edge]], str]:
+    """({input port: edges in connection order}, cache key) of ``node_id``.
+
+    The key is the sha256 of its type name and version, its validated
+    ``params``, the keys of its inputs (``keys`` must hold every upstream
+    node's), its source token and, for random nodes, the document seed and
+    node id.  The one computation of a key: evaluation and `Evaluator.adopt`
+    both call it."""
+    edges_by_port = {p.name: ports.get(p.name, []) for p in cls.inputs}
+    key_src = {
+        "t": snapshot.nodes[node_id][0], "v": cls.version, "p": params,
+        "in": {port: [[keys[e.src], e.src_port] for e in es] for port, es in edges_by_port.items()},
+    }
+    token = cls.source_token(params)
+    if token:
+        key_src["source"] = token
+    if cls.uses_rng:
+        key_src["seed"] = [snapshot.seed, node_id]
+    return edges_by_port, hashlib.sha256(_canonical(key_src).encode()).hexdigest()
+
+
 class Evaluator:
     """Evaluates snapshots, reusing cached outputs across calls.
 
@@ -141,6 +183,7 @@ class Evaluator:
         self._state: dict[str, _Held] = {}             # evaluated (or restored) this session
         self._stored: dict[str, StoredState] = {}      # imported, not yet taken up by its node
         self._pending: dict[str, StoredState] | None = None  # imported, applied at the next evaluate
+        self._adoptions: dict[str, tuple] = {}          # queue_adoption's, taken at the next evaluate
 
     def clear(self) -> None:
         with self._lock, self._state_lock:
@@ -148,6 +191,7 @@ class Evaluator:
             self._state.clear()
             self._stored.clear()
             self._pending = None
+            self._adoptions.clear()
 
     # -- stored state -----------------------------------------------------
     def import_state(self, states: dict[str, Any]) -> list[str]:
@@ -197,6 +241,80 @@ class Evaluator:
                 return
             self._cache.clear()
             self._state, self._stored, self._pending = {}, self._pending, None
+
+    # -- results computed outside an evaluation --------------------------------
+    def adopt(self, graph: GraphDocument | GraphSnapshot, node_id: str, outputs: dict[str, Any], *,
+              inputs: dict[str, Any] | None = None) -> bool:
+        """Store ``outputs`` as node ``node_id``'s result for ``graph``, as if it had evaluated.
+
+        The cache key is the one evaluation computes for that snapshot (`_cache_key`),
+        so the next evaluation of it reports the node "cached" and evaluates its
+        downstream nodes from ``outputs``; a stateful node's result is held for
+        ``ctx.previous`` and `export_state` exactly as after an evaluation.  The
+        caller vouches that ``outputs`` are what the node's ``evaluate`` returns for
+        that snapshot's parameters, seed and inputs.
+
+        inputs : {input port: value (a list for a multi port)}, optional: the values
+            ``outputs`` were computed from; refused unless each is the very object
+            (``is``) the cached upstream result feeds to that port.
+
+        Returns False and stores nothing when the key cannot be computed with
+        certainty: an unknown node or type, a parameter the node refuses, a
+        required input unconnected, a node upstream not cached under its key for
+        this snapshot (its last evaluation failed, changed or was dropped), an
+        output port missing from ``outputs``, or ``inputs`` not the cached ones.
+        Waits for a running evaluation (use `queue_adoption` from a GUI thread).
+        """
+        snap = graph.snapshot() if isinstance(graph, GraphDocument) else graph
+        with self._lock:
+            self._apply_pending()   # an import empties the cache: the adopted entry must come after
+            return self._adopt(snap, node_id, outputs, inputs)
+
+    def queue_adoption(self, graph: GraphDocument | GraphSnapshot, node_id: str, outputs: dict[str, Any], *,
+                       inputs: dict[str, Any] | None = None) -> None:
+        """`adopt` at the start of the next evaluation, on its thread (never during one).
+
+        Returns at once, even while an evaluation runs; a newer queued adoption of
+        the same node replaces this one; a refused one is logged and dropped."""
+        snap = graph.snapshot() if isinstance(graph, GraphDocument) else graph
+        with self._state_lock:
+            self._adoptions[node_id] = (snap, outputs, inputs)
+
+    def _apply_adoptions(self) -> None:
+        with self._state_lock:
+            queued, self._adoptions = self._adoptions, {}
+        for node_id, (snap, outputs, inputs) in queued.items():
+            if not self._adopt(snap, node_id, outputs, inputs):
+                log.info("the result offered for node %r was not adopted; it evaluates", node_id)
+
+    def _adopt(self, snap: GraphSnapshot, node_id: str, outputs: dict, inputs: dict | None) -> bool:
+        """`adopt` with the evaluation lock held."""
+        incoming = incoming_edges(snap)
+        keys: dict[str, str] = {}
+        try:
+            for nid in self._needed(snap, [node_id], incoming):   # upstream first, node_id last
+                cls, params = _checked(snap, nid, incoming)
+                edges_by_port, keys[nid] = _cache_key(snap, nid, cls, params, incoming.get(nid, {}), keys)
+                if nid != node_id and keys[nid] not in self._cache:
+                    return False
+        except Exception:  # no key with certainty (bad parameter, unknown type, unreadable source)
+            return False
+        if not isinstance(outputs, dict) or any(p.name not in outputs for p in cls.outputs):
+            return False
+        for port in cls.inputs if inputs is not None else ():
+            fed = [self._cache[keys[e.src]].get(e.src_port, _Missing) for e in edges_by_port[port.name]]
+            given = inputs.get(port.name)
+            if port.multi:
+                if given is None or len(given) != len(fed) or any(a is not b for a, b in zip(given, fed)):
+                    return False
+            elif given is not (fed[0] if fed else None):
+                return False
+        key = keys[node_id]
+        outputs = dict(outputs)
+        self._cache_put(key, outputs)
+        if cls.stateful:
+            self._hold(node_id, _Held(snap.nodes[node_id][0], key, params, node_seed(snap.seed, node_id), outputs))
+        return True
 
     def _hold(self, nid: str, held: _Held) -> None:
         with self._state_lock:
@@ -257,6 +375,7 @@ class Evaluator:
     def _evaluate(self, snap, targets, cancel, on_progress, on_node_done) -> EvalReport:
         t_start = time.perf_counter()
         self._apply_pending()
+        self._apply_adoptions()
         report = EvalReport()
         keys: dict[str, str] = {}
         incoming = incoming_edges(snap)  # once per evaluation, not one scan of every edge per node
@@ -272,30 +391,18 @@ class Evaluator:
         return report
 
     def _run_node(self, snap, nid, keys, report, cancel, on_progress, incoming) -> NodeResult:
-        type_name, params = snap.nodes[nid]
+        type_name, _ = snap.nodes[nid]
         ports = incoming.get(nid, {})
         upstream = [e.src for es in ports.values() for e in es]
         bad = [u for u in upstream if u not in keys]
         if bad:
             return NodeResult(nid, BLOCKED, error=f"waiting for failed input node(s) {sorted(set(bad))}")
         try:
-            cls = node_type(type_name)
-            params = cls.validate_params(params, nid)
-            check_required_inputs(snap, nid, incoming)
+            cls, params = _checked(snap, nid, incoming)
         except (GraphError, KeyError) as exc:
             msg = exc.args[0] if isinstance(exc, KeyError) else str(exc)
             return NodeResult(nid, FAILED, error=msg, where=getattr(exc, "where", "") or "")
-        edges_by_port = {p.name: ports.get(p.name, []) for p in cls.inputs}
-        key_src = {
-            "t": type_name, "v": cls.version, "p": params,
-            "in": {port: [[keys[e.src], e.src_port] for e in es] for port, es in edges_by_port.items()},
-        }
-        token = cls.source_token(params)
-        if token:
-            key_src["source"] = token
-        if cls.uses_rng:
-            key_src["seed"] = [snap.seed, nid]
-        key = hashlib.sha256(_canonical(key_src).encode()).hexdigest()
+        edges_by_port, key = _cache_key(snap, nid, cls, params, ports, keys)
         cached = self._cache_get(key)
         if cached is not None:
             if cls.stateful:
