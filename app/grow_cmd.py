@@ -40,7 +40,7 @@ def add_parser(sub) -> None:
     g = sub.add_parser("grow", help="grow an irregular tiling by virtual growth")
     g.add_argument("tileset", help="tile set name (resources/tilesets) or JSON file")
     _flags = add_param_flags(g, "Grow", GROW_FLAGS, help_extra={
-        "size": "NXxNY (2D set) or NXxNYxNZ (3D set); required",
+        "size": "NXxNY (2D set) or NXxNYxNZ (3D set)",
         "seed": "overrides the seed derived from --seed"}, required=("size",))
     g.add_argument("--seed", type=int, default=0,
                    help="document seed (default 0); the tiling seed is derived from it and the "

@@ -8,9 +8,11 @@ evaluated by the Evaluator, so the numbers are the node's Stiffness to the
 bit.  The flags come from the node schemas (`app.schema_flags`): ``--E`` and
 ``--nu`` from the Voxel node, ``--resolution`` from the Material Matrix node.
 
-Voxel grids (``.npy``, ``.vti``), pixel images (``.png``) and meshes are no
-graph input: no node loads them, so they go to the homogenization kernels
-directly, with the Voxel node's material ranges.
+A voxel grid (``.npy``, ``.vti``), a pixel image (``.png``) or a closed mesh
+is read by a Voxel Import node with a Material Matrix node on it (resolution
+0: the grid as it is), evaluated the same way; ``--E`` / ``--nu`` set the
+Voxel Import node's material (the Voxel node's parameters), ``--res`` its mesh
+voxelization.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ MATRIX_FLAGS = {"resolution": "--resolution"}
 PROJECT_SUFFIX = ".json"
 CONVENTION = "Voigt, engineering shear strains, order (xx, yy, zz, yz, xz, xy); 2D (xx, yy, xy)"
 MATRIX_ID = "homogenize"          # id of the Material Matrix node added to a project without one
+IMPORT_ID = "import"              # id of the Voxel Import node reading a file INPUT
+IMPORT_FLAGS = {"res": "--res", "E": "--E", "nu": "--nu", "path": "INPUT"}
 
 
 def add_parser(sub) -> None:
@@ -38,16 +42,10 @@ def add_parser(sub) -> None:
     voxel = add_param_flags(h, "Voxel", VOXEL_FLAGS)
     matrix = add_param_flags(h, "MaterialMatrix", MATRIX_FLAGS,
                              help_extra={"resolution": "for a .json project INPUT"})
-    h.add_argument("--res", type=int, help="voxels per edge when voxelizing a mesh INPUT (default 100)")
+    mesh = add_param_flags(h, "VoxelImport", {"res": "--res"}, help_extra={"res": "for a mesh INPUT"},
+                           typed=("res",))
     h.add_argument("--json", action="store_true", help="print a JSON summary")
-    h.set_defaults(homogenize_flags=(voxel, matrix))
-
-
-def _material(args) -> dict:
-    """``{"E": ..., "nu": ...}``: the flags given, checked by the Voxel node's schema, its defaults else."""
-    from app.schema_flags import param_values
-
-    return param_values(args, args.homogenize_flags[0], only_given=False)
+    h.set_defaults(homogenize_flags=(voxel, matrix, mesh))
 
 
 # -- a project: a small graph evaluated by the Evaluator ------------------------------------------
@@ -86,7 +84,7 @@ def _check_project(args):
     from app.schema_flags import param_values
     from engine.graph import GraphError, ProjectFileError, load_project
 
-    voxel_flags, matrix_flags = args.homogenize_flags
+    voxel_flags, matrix_flags, _ = args.homogenize_flags
     material = param_values(args, voxel_flags)      # only the flags given: the project's values stay
     matrix = param_values(args, matrix_flags)
     if args.res is not None:
@@ -142,83 +140,84 @@ def run_project(args) -> tuple[int, dict | str]:
                **stiffness_json(stiffness), "seconds": round(time.perf_counter() - t0, 4)}
 
 
-# -- a grid, an image or a mesh: the kernels (no node loads them) -------------------------------
-def check_args(args) -> tuple | None:
-    """The grid shape of a file INPUT from its header (None when unknown)
-    once every argument is checked; raises FlagError before anything is read
-    in full."""
-    from app.flags import FlagError, memory_error
-    from engine.geometry.voxel_inputs import INPUT_SUFFIXES, MAX_RES, SOLVER_BYTES_PER_DOF, check_memory, grid_shape_of
-    from engine.memory import MemoryLimitError
+# -- a grid, an image or a mesh: Voxel Import -> Material Matrix ---------------------------------
+def file_graph(path: str, params: dict):
+    """A document of a Voxel Import node reading ``path`` (with ``params`` set
+    on it: E, nu, res) and a Material Matrix node solving its grid as it is
+    (resolution 0), as the window builds it."""
+    from app.graph_run import build
 
-    # the base material's ranges are the Voxel node's, which carries them in a graph
-    material = _material(args)
-    args.E, args.nu = material["E"], material["nu"]
+    return build(0, {IMPORT_ID: ("VoxelImport", {"path": path, **params}),
+                     MATRIX_ID: ("MaterialMatrix", {"resolution": 0})},
+                 [(IMPORT_ID, "voxels", MATRIX_ID, "voxels")])
+
+
+def _unprefixed(text: str, node_id: str, type_name: str) -> str:
+    """A node's error without the ``node 'id' (Type): `` the evaluator puts before it."""
+    prefix = f"node {node_id!r} ({type_name}): "
+    return text.split(prefix, 1)[1] if prefix in text else text
+
+
+def check_args(args):
+    """The document of a file INPUT once every argument is checked against the
+    node schemas and the file's header; FlagError before the file is read."""
+    from app.evaluation import GraphMemoryError, check_graph_memory
+    from app.flags import FlagError, memory_error
+    from app.schema_flags import param_values
+    from engine.geometry.voxel_inputs import INPUT_SUFFIXES, MESH_SUFFIXES
+
+    voxel_flags, _, import_flags = args.homogenize_flags
+    params = {**param_values(args, voxel_flags), **param_values(args, import_flags)}   # the material is the Voxel node's
     if args.resolution is not None:
         raise FlagError("--resolution", args.resolution, "only for a .json project INPUT",
                         "--res for a mesh INPUT")
-    if args.res is not None and not 2 <= args.res <= MAX_RES:
-        raise FlagError("--res", args.res, "out of range", f"an integer in [2, {MAX_RES}]")
     suffix = Path(args.input).suffix.lower()
     if suffix not in INPUT_SUFFIXES:
         raise FlagError("INPUT", args.input, f"unsupported extension {suffix!r}" if suffix else "no extension",
                         "a file ending in " + ", ".join((PROJECT_SUFFIX,) + tuple(INPUT_SUFFIXES)))
     if not Path(args.input).is_file():
         raise FlagError("INPUT", args.input, "no such file", "an existing file")
-    shape = grid_shape_of(args.input, res=args.res)
-    if shape is not None:
-        try:
-            check_memory(shape, per_dof_bytes=SOLVER_BYTES_PER_DOF)
-        except MemoryLimitError as exc:
-            if args.res is not None:
-                raise memory_error("--res", args.res, exc, lower="--res") from None
-            raise FlagError("INPUT", args.input, str(exc)) from None
-    return shape
+    if "res" in params and suffix not in MESH_SUFFIXES:
+        raise FlagError("--res", args.res, "only for a mesh INPUT", "grids and images are read as they are")
+    doc = file_graph(args.input, params)
+    try:
+        check_graph_memory(doc)           # the grid's shape from the file's header: nothing is read
+    except GraphMemoryError as exc:
+        if "res" in params:
+            raise memory_error("--res", args.res, exc, lower="--res") from None
+        raise FlagError("INPUT", args.input, _unprefixed(str(exc), exc.node, exc.type_name)) from None
+    return doc
 
 
 def run_file(args) -> tuple[int, dict | str]:
-    """Homogenize a voxel grid, pixel image or mesh: ``(0, summary)`` or ``(code, message)``."""
+    """Homogenize a voxel grid, pixel image or mesh through the graph:
+    ``(0, summary)`` or ``(code, message)``."""
     from app.flags import FlagError
-    from engine.geometry.voxel_inputs import load_voxel_grid, validate_density
-    from engine.physics.elastic import engineering_constants, symmetry_class, zener_ratio
-    from engine.physics.homogenize2d import homogenize_pixels
-    from engine.physics.homogenize3d import homogenize_voxels
+    from app.graph_run import GraphRunFailed, evaluate
 
     try:
-        check_args(args)
+        doc = check_args(args)
     except FlagError as exc:
         return 2, str(exc)
-    try:
-        grid, kind, info = load_voxel_grid(args.input, res=args.res)
-        validate_density(grid, cubic=(kind == "voxels"))
-    except (ValueError, OSError) as exc:
-        return 2, f"INPUT {args.input}: {exc}"
     t0 = time.perf_counter()
     try:
-        solve = homogenize_voxels if kind == "voxels" else homogenize_pixels
-        result = solve(np.asarray(grid, dtype=np.float64), E=args.E, nu=args.nu)
-    except MemoryError as exc:     # the solver's own check, on the exact solid count
-        return 2, f"INPUT {args.input}: {exc}"
-    except ValueError as exc:
-        return 1, str(exc)
-    C = np.asarray(result.C)
-    try:
-        sym = symmetry_class(C, tol=1e-3)
-        constants = engineering_constants(C)
-    except ValueError:  # a mechanism: C is singular, no compliance
-        sym, constants = "singular", {}
-    out = {
-        "input": args.input, "kind": kind, "shape": list(grid.shape), "E": args.E, "nu": args.nu,
-        "density": float(result.density), "dropped_fraction": float(result.dropped_fraction),
-        "C": C.tolist(), "S": np.linalg.inv(C).tolist() if constants else None, "constants": constants,
-        "symmetry": sym, "zener": float(zener_ratio(C)) if sym == "cubic" else None,
-        "iterations": int(result.iterations), "seconds": round(time.perf_counter() - t0, 4),
-        "convention": CONVENTION,
-        **({"source": info} if info else {}),
-    }
-    if kind == "pixels" and sym != "singular":
+        report = evaluate(doc, flag_of={"VoxelImport": IMPORT_FLAGS, "MaterialMatrix": {}})
+    except GraphRunFailed as exc:
+        if exc.node_id == IMPORT_ID and exc.where == "path":          # the file is refused
+            return 2, f"INPUT {args.input}: {_unprefixed(str(exc), IMPORT_ID, 'VoxelImport')}"
+        text = _unprefixed(str(exc), MATRIX_ID, "MaterialMatrix")
+        if exc.node_id == MATRIX_ID and text.startswith("MemoryError: "):   # the solver's exact count
+            return 2, f"INPUT {args.input}: {text[len('MemoryError: '):]}"
+        return 1, text
+    voxels, stiffness = report.outputs[IMPORT_ID]["voxels"], report.outputs[MATRIX_ID]["stiffness"]
+    out = {"input": args.input, "kind": voxels.kind, **stiffness_json(stiffness)}
+    convention = out.pop("convention")
+    out.update({"seconds": round(time.perf_counter() - t0, 4), "convention": convention})
+    if voxels.info:
+        out["source"] = voxels.info
+    if voxels.kind == "pixels" and stiffness.symmetry != "singular":
         from engine.physics.material_sphere import material_polar
-        theta, e_theta = material_polar(C, n=72)
+        theta, e_theta = material_polar(np.asarray(stiffness.C), n=72)
         out["polar"] = {"theta_deg": np.degrees(theta).round(6).tolist(), "E": e_theta.tolist()}
     return 0, out
 

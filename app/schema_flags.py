@@ -46,8 +46,8 @@ def _param(type_name: str, name: str):
     return node_type(type_name).param(name)
 
 
-def help_text(p, extra: str = "") -> str:
-    """A flag's help: the parameter's doc, unit, allowed values and default."""
+def help_text(p, extra: str = "", *, required: bool = False) -> str:
+    """A flag's help: the parameter's doc, unit, allowed values and default (none when required)."""
     parts = [p.doc or p.label or p.name]
     if extra:
         parts.append(extra)
@@ -65,8 +65,11 @@ def help_text(p, extra: str = "") -> str:
         default = json.dumps(default)
     elif p.kind == "str" and default == "":
         default = '""'
-    unit = f" {p.unit}" if p.unit and default != "none" and p.kind in ("float", "int", "int_list", "vec3") else ""
-    parts.append(f"default: {default}{unit}")
+    unit = f" {p.unit}" if p.unit and p.kind in ("float", "int", "int_list", "vec3") else ""
+    if required:
+        parts.append(f"required{f'; unit: {p.unit}' if unit else ''}")
+    else:
+        parts.append(f"default: {default}{unit if default != 'none' else ''}")
     return "; ".join(parts).replace("%", "%%")
 
 
@@ -89,7 +92,7 @@ def add_param_flags(parser, type_name: str, params: Mapping[str, str] | Sequence
     for name, flag in mapping.items():
         p = _param(type_name, name)
         dest = dest_prefix + flag.lstrip("-").replace("-", "_")
-        text = help_text(p, extra.get(name, ""))
+        text = help_text(p, extra.get(name, ""), required=name in required)
         if p.kind == "bool":
             parser.add_argument(flag, dest=dest, action=argparse.BooleanOptionalAction, default=None, help=text)
         elif p.kind == "enum":

@@ -159,8 +159,11 @@ def _remove_if_unlocked(name: str, st: os.stat_result) -> bool:
 
 def file_digest(path: str | os.PathLike) -> str:
     """sha256 hex digest of a file's bytes; "" when it cannot be read."""
+    h = hashlib.sha256()
     try:
         with open(path, "rb") as fh:
-            return hashlib.sha256(fh.read()).hexdigest()
+            for block in iter(lambda: fh.read(1 << 20), b""):      # 1 MiB at a time: no whole-file copy
+                h.update(block)
     except OSError:
         return ""
+    return h.hexdigest()

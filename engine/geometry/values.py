@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["frozen_array", "read_only_array", "Point", "EdgeChain", "LineElement", "SurfaceElement",
-           "Skeleton", "Solid", "VoxelModel", "Field", "MeshValue"]
+           "Skeleton", "Solid", "VoxelModel", "ImportedVoxels", "Field", "MeshValue"]
 
 
 def frozen_array(a, dtype=np.float64) -> np.ndarray:
@@ -279,3 +279,41 @@ class MeshValue:
     def bounds(self) -> tuple:
         """(lo, hi) (3,) float64 mm, the bounding box."""
         return self.vertices.min(axis=0), self.vertices.max(axis=0)
+
+
+@dataclass(frozen=True)
+class ImportedVoxels(VoxelModel):
+    """Voxels read from a file (port type "Voxel").
+
+    density : float64, read-only, values in [0, 1] (1 = solid), the grid as
+        :func:`load_voxel_grid` returns it: ``[x, y, z]`` voxels (a cube) or
+        ``[row, col]`` pixels (row 0 = top of the image); what is homogenized.
+    kind : "voxels" (3D) or "pixels" (2D, plane stress).
+    info : the reader's description of the file (source, format, shape,
+        volume fraction, per-format details).
+
+    ``occupancy`` (``density >= 0.5``) and ``solid`` (that level set, no mesh)
+    are the `VoxelModel` view: ``[x, y, z]`` over the unit cube, or for pixels
+    a one-pixel-thick ``(nx, ny, 1)`` slab of the box ``(nx, ny, 1) / max(nx, ny)``.
+    """
+
+    density: np.ndarray = None
+    kind: str = "voxels"
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        super().__post_init__()
+        object.__setattr__(self, "density", read_only_array(self.density, np.float64))
+        if self.kind not in ("voxels", "pixels") or self.density.ndim != (3 if self.kind == "voxels" else 2):
+            raise ValueError(f"ImportedVoxels: a {self.kind!r} grid cannot have shape {self.density.shape}")
+
+    @classmethod
+    def from_grid(cls, grid, kind: str, info: dict, *, E: float, nu: float, rho: float) -> "ImportedVoxels":
+        """The value of a grid read by `load_voxel_grid` (``grid`` is kept, made read-only)."""
+        grid = np.asarray(grid, dtype=np.float64)
+        grid.setflags(write=False)
+        xyz = grid if kind == "voxels" else grid[::-1, :].T[:, :, None]     # [row, col] -> [x, y, 0]
+        cell = (1.0, 1.0, 1.0) if kind == "voxels" else tuple(n / max(xyz.shape) for n in xyz.shape)
+        empty = np.zeros((0, 3))
+        solid = Solid((0.5 - xyz).astype(np.float32), empty, empty, cell=cell)
+        return cls(xyz >= 0.5, E, nu, rho, solid, density=grid, kind=kind, info=dict(info))

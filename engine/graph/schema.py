@@ -131,7 +131,8 @@ class Param:
             self._check_range(x)
             return x
         if k == "int":
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or (
+                    isinstance(value, float) and not (math.isfinite(value) and value.is_integer())):
                 raise ParamError(self.name, value, "an integer")
             x = int(value)
             self._check_range(x)
@@ -160,7 +161,8 @@ class Param:
                 raise ParamError(self.name, value, "a list of integers")
             out = []
             for v in value:
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or int(v) != v:
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or (
+                        isinstance(v, float) and not (math.isfinite(v) and v.is_integer())):
                     raise ParamError(self.name, value, "a list of integers")
                 out.append(int(v))
                 self._check_range(int(v), value)

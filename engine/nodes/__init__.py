@@ -6,4 +6,5 @@ from . import phasor_preview  # noqa: F401
 from . import rd  # noqa: F401
 from . import rd_topopt  # noqa: F401
 from . import surfaces  # noqa: F401
+from . import voxel_import  # noqa: F401
 from . import codecs  # noqa: F401  (how stateful nodes' values are kept in project files)

@@ -7,10 +7,13 @@ import numpy as np
 from engine.geometry.box_cell import box_grid_shape
 from engine.geometry.resample import resample_periodic
 from engine.geometry.voxel_inputs import SOLVER_BYTES_PER_DOF, memory_estimate_bytes
+from engine.geometry.values import ImportedVoxels
+from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.physics.values import Stiffness
 from engine.physics.elastic import engineering_constants, is_singular, symmetry_class, zener_ratio
+from engine.physics.homogenize2d import homogenize_pixels
 from engine.physics.homogenize3d import homogenize_voxels
 
 
@@ -38,7 +41,9 @@ def stiffness_from_result(result, *, E, nu, rho, resolution, grid_shape=None, ce
 class MaterialMatrixNode(NodeType):
     """Effective stiffness tensor C of the periodic cell by voxel homogenization
     (trilinear hexes, periodic boundary conditions), with engineering constants.
-    A box cell is solved on box voxels (edges ``L_i / n_i``); C is in the box's axes."""
+    A box cell is solved on box voxels (edges ``L_i / n_i``); C is in the box's axes.
+    A grid read by a Voxel Import node is solved as it is (its densities; 2D in
+    plane stress, a 3x3 C)."""
 
     type_name = "MaterialMatrix"
     title = "Material Matrix"
@@ -48,8 +53,8 @@ class MaterialMatrixNode(NodeType):
     outputs = (Port("stiffness", "Stiffness"),)
     params = (
         Param("resolution", "int", 64, 0, 256, unit="voxels",
-              doc="voxels along the longest cell edge for the solve (0 = the Object grid as is); "
-                  "the paper used 100"),
+              doc="voxels along the longest cell edge for the solve (0 = the Object grid as is; "
+                  "an imported grid is never resampled); the paper used 100"),
     )
 
     memory_param = "resolution"
@@ -60,6 +65,8 @@ class MaterialMatrixNode(NodeType):
         one model ``mesoforge homogenize`` uses too); resolution 0 needs the
         Voxel input's grid, unknown before it is evaluated."""
         vox = (inputs_shape_info or {}).get("voxels")
+        if isinstance(vox, ImportedVoxels):
+            return memory_estimate_bytes(vox.density.shape, per_dof_bytes=SOLVER_BYTES_PER_DOF)
         n = params["resolution"]
         cell = (1.0, 1.0, 1.0) if vox is None else tuple(vox.solid.cell)
         if n:
@@ -72,6 +79,8 @@ class MaterialMatrixNode(NodeType):
 
     def evaluate(self, inputs, params, ctx):
         vox = inputs["voxels"]
+        if isinstance(vox, ImportedVoxels):
+            return {"stiffness": imported_stiffness(vox, params["resolution"], progress=ctx.progress)}
         solid = vox.solid
         n = params["resolution"]
         box = None if solid.is_unit_cube else solid.cell
@@ -90,3 +99,22 @@ class MaterialMatrixNode(NodeType):
                                                    resolution=max(occupancy.shape),
                                                    grid_shape=None if box is None else occupancy.shape,
                                                    cell=box)}
+
+
+def imported_stiffness(vox: ImportedVoxels, resolution: int, *, progress=None) -> Stiffness:
+    """The Stiffness of a grid read by a Voxel Import node, solved on the grid as
+    it was read: `homogenize_voxels` for voxels, `homogenize_pixels` (plane
+    stress, a 3x3 C, ``grid_shape`` = (rows, columns)) for pixels.
+
+    Raises NodeInputError (where "resolution") when ``resolution`` is neither 0
+    nor the grid's size: an imported grid is not resampled.
+    """
+    grid = vox.density
+    if resolution and resolution != max(grid.shape):
+        shape = "x".join(map(str, grid.shape))
+        raise NodeInputError(f"an imported {shape} grid is solved as it is (no resampling): "
+                             f"set resolution to 0", where="resolution")
+    solve = homogenize_voxels if vox.kind == "voxels" else homogenize_pixels
+    result = solve(grid, E=vox.E, nu=vox.nu, progress=progress)
+    return stiffness_from_result(result, E=vox.E, nu=vox.nu, rho=vox.rho, resolution=max(grid.shape),
+                                 grid_shape=None if vox.kind == "voxels" else grid.shape)

@@ -1,5 +1,7 @@
-"""`mesoforge homogenize PROJECT.json` is the Material Matrix node: the CLI's
-numbers are the Stiffness a window-built document gives, bit for bit."""
+"""`mesoforge homogenize PROJECT.json` is the Material Matrix node, and
+`mesoforge homogenize GRID` (.npy .vti .png or a mesh) the Voxel Import ->
+Material Matrix nodes: the CLI's numbers are the Stiffness a window-built
+document gives, bit for bit."""
 
 from __future__ import annotations
 
@@ -122,3 +124,115 @@ def test_help_shows_the_schema_ranges_and_units(capsys):
     for name in ("E", "nu"):
         q = node_type("Voxel").param(name)
         assert f"default: {q.default}{' ' + q.unit if q.unit else ''}" in text
+
+
+# -- a grid, an image or a mesh: Voxel Import -> Material Matrix ---------------------------------
+def _npy(path):
+    grid = np.zeros((6, 6, 6))
+    grid[:, 2:4, :] = 1.0
+    grid[2:4, :, :] = 1.0
+    grid[:, :, 2:4] = 0.5            # a density between solid and void stays a density
+    np.save(path, grid)
+
+
+def _vti(path):
+    import pyvista as pv
+
+    grid = np.zeros((5, 5, 5))
+    grid[1:3, :, :] = 1.0
+    grid[:, 1:3, :] = 1.0
+    grid[:, :, 1:3] = 1.0
+    image = pv.ImageData(dimensions=(6, 6, 6))
+    image.cell_data["rho"] = grid.ravel(order="F")
+    image.save(path)
+
+
+def _png(path):
+    from PIL import Image
+
+    image = np.full((12, 16), 255, np.uint8)
+    image[:, 3:6] = 0
+    image[5:8, :] = 40
+    Image.fromarray(image).save(path)
+
+
+def _stl(path):
+    import trimesh
+
+    trimesh.creation.annulus(r_min=0.2, r_max=0.45, height=1.0, sections=20).export(path)
+
+
+FILE_KINDS = {"npy": (_npy, ["--E", 2.0, "--nu", 0.3], {"E": 2.0, "nu": 0.3}, "voxels"),
+              "vti": (_vti, [], {}, "voxels"),
+              "png": (_png, ["--nu", 0.2], {"nu": 0.2}, "pixels"),
+              "stl": (_stl, ["--res", 9], {"res": 9}, "voxels")}
+
+
+def import_document(path, params: dict, resolution: int = 0):
+    """Voxel Import -> Material Matrix, by the commands the window pushes."""
+    doc = GraphDocument(seed=0)
+    undo = UndoStack(doc)
+    imp = undo.push(AddNode("VoxelImport", {}, (0, 0))).node_id
+    undo.push(SetParam(imp, "path", str(path)))
+    for name, value in params.items():
+        undo.push(SetParam(imp, name, value))
+    mm = undo.push(AddNode("MaterialMatrix", {"resolution": resolution}, (240, 0))).node_id
+    undo.push(Connect(imp, "voxels", mm, "voxels"))
+    return doc, imp, mm
+
+
+@pytest.mark.parametrize("kind", sorted(FILE_KINDS))
+def test_file_cli_numbers_are_the_voxel_import_material_matrix_nodes(tmp_path, capsys, kind):
+    write, argv, params, grid_kind = FILE_KINDS[kind]
+    path = tmp_path / f"cell.{kind}"
+    write(path)
+    code, out, err = homogenize(capsys, path, *argv, "--json")
+    assert code == 0, err
+    out = json.loads(out)
+
+    doc, imp, mm = import_document(path, params)
+    report = Evaluator().evaluate(doc)
+    assert report.ok, report.errors
+    st = report.outputs[mm]["stiffness"]
+    assert_same_numbers(out, st)
+    voxels = report.outputs[imp]["voxels"]
+    assert out["kind"] == voxels.kind == grid_kind
+    assert out["shape"] == list(voxels.density.shape) == list(st.grid_shape or (st.resolution,) * 3)
+    assert json.loads(json.dumps(voxels.info, default=float)) == out["source"]
+    if grid_kind == "pixels":
+        from engine.physics.material_sphere import material_polar
+
+        theta, e_theta = material_polar(st.C, n=72)
+        assert out["polar"]["E"] == e_theta.tolist() and st.C.shape == (3, 3)
+
+
+def test_file_flags_are_the_voxel_import_nodes(tmp_path, capsys):
+    from engine.nodes.solids import VoxelNode
+    from engine.nodes.voxel_import import VoxelImportNode
+
+    for name in ("E", "nu", "rho"):
+        assert VoxelImportNode.param(name) is VoxelNode.param(name)        # one schema for the material
+    res = VoxelImportNode.param("res")
+    path = tmp_path / "ring.stl"
+    _stl(path)
+    code, _, err = homogenize(capsys, path, "--res", res.maximum + 1)
+    assert code == 2 and f"--res {res.maximum + 1}" in err and f"{res.maximum}" in err
+    grid = tmp_path / "cell.npy"
+    _npy(grid)
+    code, _, err = homogenize(capsys, grid, "--res", 6)
+    assert code == 2 and "--res 6" in err and "mesh" in err
+    code, _, err = homogenize(capsys, grid, "--resolution", 6)
+    assert code == 2 and "--resolution 6" in err and ".json" in err
+
+
+def test_an_unreadable_file_is_refused_as_input(tmp_path, capsys):
+    import trimesh
+
+    path = tmp_path / "open.stl"
+    box = trimesh.creation.box()
+    box.faces = box.faces[:-1]
+    box.export(path)
+    code, out, err = homogenize(capsys, path, "--res", 8)
+    assert code == 2 and not out
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"mesoforge homogenize: INPUT {path}: mesh open.stl is not watertight")
