@@ -17,8 +17,11 @@ def create_main_window(project_path: str | Path | None = None, autosave_dir: str
     """A MainWindow (a QApplication must exist) with `project_path` opened.
 
     Without a project, ``open_example=True`` loads the default example
-    (``resources/examples/octet.json``) when it is present.  With
-    ``offer_recovery=True`` a crashed session's autosave is offered first.
+    (``resources/examples/octet.json``) when it is present.  A shipped file
+    (the default example ``mesoforge`` launches with, or any file under
+    ``resources/``) opens as an untitled copy, so Save asks for a path and the
+    shipped file is never overwritten.  With ``offer_recovery=True`` a crashed
+    session's autosave is offered first.
     """
     extra = {} if autosave_interval_ms is None else {"autosave_interval_ms": autosave_interval_ms}
     window = MainWindow(autosave_dir=autosave_dir, prompter=prompter, **extra)

@@ -2,8 +2,11 @@
 
 Every edit becomes a `SetParam` pushed on the undo stack (successive edits of
 one parameter within a second merge into one undo item, as when holding a
-spin box arrow; `ui.param_push`).  A value the engine refuses is shown inline
-and the editor goes back to the document's value; the document is unchanged.
+spin box arrow; `ui.param_push`).  A typed value is never clamped: one the
+schema refuses (out of range, not a number) is refused at its field -- a red
+frame and a message under it naming the parameter, the value typed and what
+is allowed -- and the editor goes back to the document's value; the document
+and the undo stack are unchanged.
 Widgets are refreshed from document events, so undo/redo shows up here too.
 When the node's latest evaluation produced a `Stiffness`, a `StiffnessPanel`
 shows it under the parameters.  One editor class per parameter kind lives in
@@ -20,6 +23,7 @@ from engine.graph import GraphDocument, GraphError, SetLabel, UndoStack, all_nod
 from engine.physics.values import Stiffness
 
 from .colours import STATUS_COLOURS, family_colour
+from .field_message import FieldMessage, refusal_text
 from .param_editors import (BoolEditor, EnumEditor, FloatEditor, IntEditor, IntListEditor, ParamEditor, StrEditor,
                             Vec3Editor)
 from .param_push import MergingParamPush
@@ -44,6 +48,9 @@ class Inspector(QtWidgets.QWidget):
         self.undo = undo
         self.node_id: str | None = None
         self.editors: dict[str, ParamEditor] = {}
+        self.messages: dict[str, FieldMessage] = {}   # the refusal message under each field
+        self._refused: FieldMessage | None = None       # the latest refusal shown
+        self._no_refusal = FieldMessage([], self)
         self._results: dict = {}
         self._outputs: dict = {}
         self._edits = MergingParamPush(undo)
@@ -69,6 +76,8 @@ class Inspector(QtWidgets.QWidget):
         self.label_edit.editingFinished.connect(self._commit_label)
         ident.addRow("id", self.id_label)
         ident.addRow("label", self.label_edit)
+        self.label_message = FieldMessage([self.label_edit])
+        ident.addRow(self.label_message)
         self.ident_box = QtWidgets.QWidget()
         self.ident_box.setLayout(ident)
         outer.addWidget(self.ident_box)
@@ -81,13 +90,6 @@ class Inspector(QtWidgets.QWidget):
         self.stiffness_panel = StiffnessPanel()
         self.stiffness_panel.hide()
         outer.addWidget(self.stiffness_panel)
-
-        self.error_label = QtWidgets.QLabel("")
-        self.error_label.setWordWrap(True)
-        self.error_label.setStyleSheet("color: #e04040;")
-        self.error_label.setTextInteractionFlags(QtCore.Qt.TextInteractionFlag.TextSelectableByMouse)
-        self.error_label.hide()
-        outer.addWidget(self.error_label)
 
         self.status_box = QtWidgets.QGroupBox("Evaluation")
         sl = QtWidgets.QVBoxLayout(self.status_box)
@@ -111,7 +113,7 @@ class Inspector(QtWidgets.QWidget):
         self.node_id = node_id
         self._edits.reset()
         self._clear_form()
-        self.error_label.hide()
+        self.label_message.clear()
         has = node_id is not None
         for w in (self.ident_box, self.params_box, self.status_box):
             w.setVisible(has)
@@ -132,9 +134,13 @@ class Inspector(QtWidgets.QWidget):
             editor = EDITORS[param.kind](param, self)
             editor.set_value(inst.params.get(param.name, param.default))
             editor.edited.connect(lambda value, _name=param.name: self.commit(_name, value))
-            label = param.label or param.name.replace("_", " ")
+            label = QtWidgets.QLabel(param.label or param.name.replace("_", " "))
+            label.setToolTip(editor.tooltip)
             self.form.addRow(label, editor.widget)
+            message = FieldMessage(editor.inputs())
+            self.form.addRow(message)
             self.editors[param.name] = editor
+            self.messages[param.name] = message
         self.params_box.setVisible(bool(cls.params))
         self._show_status()
 
@@ -144,27 +150,52 @@ class Inspector(QtWidgets.QWidget):
         for e in self.editors.values():
             e.deleteLater()
         self.editors = {}
+        self.messages = {}
+        self._refused = None
 
     def editor_widget(self, name: str) -> QtWidgets.QWidget:
         """The input widget of parameter `name` (tests drive it like a user would)."""
         editor = self.editors[name]
         return getattr(editor, "box", None) or getattr(editor, "table", None) or editor.widget
 
+    @property
+    def error_label(self) -> QtWidgets.QLabel:
+        """The message of the latest refusal, under its field (a hidden label when none)."""
+        return self._refused if self._refused is not None else self._no_refusal
+
     # -- edits ------------------------------------------------------------------
     def commit(self, name: str, value: Any) -> bool:
-        """Push SetParam for the shown node; show a refusal inline."""
+        """Push SetParam for the shown node (nothing when `value` is the stored one);
+        a refused value is shown at its field and changes nothing."""
         if self.node_id is None:
             return False
+        params = self.doc.nodes[self.node_id].params
+        message = self.messages.get(name)
+        if name in params and _same(value, params[name]):
+            self._refresh_values()                      # e.g. "32" retyped: no undo item
+            if message is not None:
+                message.clear()
+            return True
         try:
             self._edits.push(self.node_id, name, value)
         except GraphError as exc:
-            self.error_label.setText(str(exc))
-            self.error_label.show()
-            self.message.emit("error", f"refused: {exc}")
             self._refresh_values()
+            self.refuse(name, exc)
             return False
-        self.error_label.hide()
+        if message is not None:
+            message.clear()
         return True
+
+    def refuse(self, name: str, exc: GraphError) -> None:
+        """Show why `name`'s new value was refused, at its field and in the log."""
+        param = self.editors[name].param if name in self.editors else None
+        params = self.doc.nodes[self.node_id].params if self.node_id in self.doc.nodes else {}
+        text = refusal_text(param, exc, params.get(name)) if param is not None else str(exc)
+        message = self.messages.get(name)
+        if message is not None:
+            message.refuse(text)
+            self._refused = message
+        self.message.emit("error", f"refused: {exc}")
 
     def _commit_label(self) -> None:
         if self.node_id is None:
@@ -174,7 +205,11 @@ class Inspector(QtWidgets.QWidget):
             try:
                 self.undo.push(SetLabel(self.node_id, text))
             except GraphError as exc:
+                self.label_message.refuse(f"label {text!r} refused: {exc}")
+                self.label_edit.setText(self.doc.nodes[self.node_id].label)
                 self.message.emit("error", f"refused: {exc}")
+                return
+        self.label_message.clear()
 
     def _refresh_values(self) -> None:
         if self.node_id is None or self.node_id not in self.doc.nodes:
@@ -191,6 +226,7 @@ class Inspector(QtWidgets.QWidget):
             editor = self.editors.get(payload[1])
             if editor is not None:
                 editor.set_value(self.doc.nodes[self.node_id].params[payload[1]])
+                self.messages[payload[1]].clear()       # an undo / redo made the refusal stale
         elif event == "label_changed" and payload == self.node_id:
             self.label_edit.setText(self.doc.nodes[self.node_id].label)
         elif (event == "node_removed" and payload == self.node_id) or event == "reset":
@@ -237,6 +273,13 @@ class Inspector(QtWidgets.QWidget):
 
     def status_text(self) -> str:
         return self.status_label.text()
+
+
+def _same(value: Any, stored: Any) -> bool:
+    """Whether an edit would store what is stored already (same type and value)."""
+    if isinstance(value, (list, tuple)) and isinstance(stored, (list, tuple)):
+        return len(value) == len(stored) and all(_same(a, b) for a, b in zip(value, stored))
+    return type(value) is type(stored) and value == stored
 
 
 def _escape(text: str) -> str:

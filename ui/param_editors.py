@@ -2,74 +2,35 @@
 
 An editor's ``widget`` is what goes in a form; ``edited(value)`` fires when
 the user changed the value, ``set_value`` shows the document's value without
-emitting.  Ranges, units and tooltips come from the `Param` schema.
+emitting.  A typed value is handed over as typed -- never clamped to the
+range, rounded or dropped -- so the schema (`Param.coerce`, through
+`SetParam`) refuses it with a message the owner shows at the field.  Ranges,
+units and tooltips come from the `Param` schema.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any, Callable
 
-from PySide6 import QtCore, QtGui, QtWidgets
+from PySide6 import QtCore, QtWidgets
 
 from engine.graph import Param
 
-_BIG = 1e15
+from .field_message import param_tooltip
+from .number_box import NumberBox
 
 
-class SciSpinBox(QtWidgets.QDoubleSpinBox):
-    """A float spin box that shows values with 6 significant digits, so both
-    1e-4 and 2e11 read well, and steps by a tenth of the value's magnitude."""
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.setDecimals(15)
-        self.setKeyboardTracking(False)
-        self.setRange(-_BIG, _BIG)
-        self.setAccelerated(True)
-
-    def textFromValue(self, value: float) -> str:
-        return f"{value:.6g}"
-
-    def valueFromText(self, text: str) -> float:
-        try:
-            return float(self._strip(text))
-        except ValueError:
-            return self.value()
-
-    def validate(self, text: str, pos: int):
-        body = self._strip(text)
-        try:
-            float(body)
-            return QtGui.QValidator.State.Acceptable, text, pos
-        except ValueError:
-            ok = all(c in "0123456789+-.eE" for c in body)
-            state = QtGui.QValidator.State.Intermediate if ok else QtGui.QValidator.State.Invalid
-            return state, text, pos
-
-    def _strip(self, text: str) -> str:
-        body = text.strip()
-        if self.suffix() and body.endswith(self.suffix().strip()):
-            body = body[: -len(self.suffix().strip())]
-        return body.strip()
-
-    def stepBy(self, steps: int) -> None:
-        a = abs(self.value())
-        step = 0.01 if a < 1e-12 else 10.0 ** (math.floor(math.log10(a)) - 1)
-        self.setValue(self.value() + steps * step)
-
-
-def float_box(param: Param) -> SciSpinBox:
-    """A SciSpinBox over the parameter's range, with its unit as suffix."""
-    box = SciSpinBox()
-    box.setRange(-_BIG if param.minimum is None else param.minimum, _BIG if param.maximum is None else param.maximum)
-    if param.unit:
-        box.setSuffix(f" {param.unit}")
-    return box
+def number_box(param: Param, integer: bool = False) -> NumberBox:
+    """A NumberBox stepping within the parameter's range, with its unit; typed
+    values are not limited by it (the schema refuses them with a message)."""
+    return NumberBox(integer, param.minimum, param.maximum, param.unit)
 
 
 class ParamEditor(QtCore.QObject):
-    """Edits one parameter.  `edited(value)` when the user changed it; `set_value` never emits."""
+    """Edits one parameter.  `edited(value)` when the user changed it (the value
+    as typed: out of range or not a number, for the schema to refuse);
+    `set_value` never emits.  Every input's tooltip gives the parameter's doc,
+    allowed range, unit and default."""
 
     edited = QtCore.Signal(object)
 
@@ -77,16 +38,16 @@ class ParamEditor(QtCore.QObject):
         super().__init__(parent)
         self.param = param
         self.widget = self._build()
-        tip = param.doc
-        rng = self._range_text()
-        self.widget.setToolTip("\n".join(t for t in (tip, rng) if t))
+        self.tooltip = param_tooltip(param)
+        self.widget.setToolTip(self.tooltip)
+        for w in self.inputs():
+            if w is not self.widget:
+                w.setToolTip(self.tooltip if not w.toolTip() else f"{w.toolTip()}: {self.tooltip}")
 
-    def _range_text(self) -> str:
-        lo, hi = self.param.minimum, self.param.maximum
-        if lo is None and hi is None:
-            return ""
-        unit = f" {self.param.unit}" if self.param.unit else ""
-        return f"range [{'-inf' if lo is None else f'{lo:g}'}, {'inf' if hi is None else f'{hi:g}'}]{unit}"
+    def inputs(self) -> list[QtWidgets.QWidget]:
+        """The widgets a user types or clicks in (framed red on a refusal)."""
+        box = getattr(self, "box", None) or getattr(self, "table", None)
+        return [box] if box is not None else [self.widget]
 
     def _build(self) -> QtWidgets.QWidget:  # pragma: no cover - overridden
         raise NotImplementedError
@@ -105,30 +66,24 @@ class ParamEditor(QtCore.QObject):
 
 class FloatEditor(ParamEditor):
     def _build(self):
-        self.box = float_box(self.param)
-        self.box.valueChanged.connect(lambda v: self.edited.emit(float(v)))
+        self.box = number_box(self.param)
+        self.box.committed.connect(self.edited.emit)
         return self.box
 
     def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setValue(float(value)))
+        self._blocked([self.box], lambda: self.box.show_value(float(value)))
 
 
 class IntEditor(ParamEditor):
+    """Any Python int (64-bit seeds too): no 32-bit QSpinBox."""
+
     def _build(self):
-        self.box = QtWidgets.QSpinBox()
-        # a QSpinBox holds 32-bit integers: wider schema ranges are cut to what it can show
-        lo = max(-(2**31 - 1), -(2**31 - 1) if self.param.minimum is None else int(self.param.minimum))
-        hi = min(2**31 - 1, 2**31 - 1 if self.param.maximum is None else int(self.param.maximum))
-        self.box.setRange(lo, hi)
-        self.box.setKeyboardTracking(False)
-        self.box.setAccelerated(True)
-        if self.param.unit:
-            self.box.setSuffix(f" {self.param.unit}")
-        self.box.valueChanged.connect(lambda v: self.edited.emit(int(v)))
+        self.box = number_box(self.param, integer=True)
+        self.box.committed.connect(self.edited.emit)
         return self.box
 
     def set_value(self, value):
-        self._blocked([self.box], lambda: self.box.setValue(int(value)))
+        self._blocked([self.box], lambda: self.box.show_value(int(value)))
 
 
 class BoolEditor(ParamEditor):
@@ -171,18 +126,22 @@ class Vec3Editor(ParamEditor):
         lay.setSpacing(2)
         self.boxes = []
         for axis in "xyz":
-            box = float_box(Param(self.param.name, "float", 0.0, self.param.minimum, self.param.maximum))
+            box = number_box(self.param)
             box.setToolTip(axis)
             box.setMinimumWidth(56)
-            box.valueChanged.connect(lambda _v: self.edited.emit([b.value() for b in self.boxes]))
+            # the untouched components keep their exact values (not the 6 digits shown)
+            box.committed.connect(lambda _v: self.edited.emit([b.current() for b in self.boxes]))
             lay.addWidget(box)
             self.boxes.append(box)
         return w
 
+    def inputs(self):
+        return list(self.boxes)
+
     def set_value(self, value):
         def apply():
             for box, v in zip(self.boxes, value):
-                box.setValue(float(v))
+                box.show_value(float(v))
         self._blocked(self.boxes, apply)
 
 

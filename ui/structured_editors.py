@@ -38,12 +38,20 @@ class SamplesEditor(ParamEditor):
         return w
 
     def rows(self) -> list:
+        """The table as typed: an untouched cell keeps the document's exact value
+        (not the 6 digits shown), a cell that reads as no number its text (refused
+        by the schema with a message)."""
         out = []
+        shown = getattr(self, "_shown", [])
         for r in range(self.table.rowCount()):
             cells = []
             for c in range(2):
                 item = self.table.item(r, c)
                 text = item.text().strip() if item is not None else ""
+                stored = shown[r][c] if r < len(shown) and c < len(shown[r]) else None
+                if stored is not None and text == _cell_text(stored):
+                    cells.append(stored)
+                    continue
                 try:
                     cells.append(float(text))
                 except ValueError:
@@ -76,6 +84,8 @@ class SamplesEditor(ParamEditor):
         self.edited.emit(rows)
 
     def set_value(self, value):
+        self._shown = [list(pair) for pair in value]
+
         def apply():
             # Items are updated in place: this may run inside the table's own
             # cellChanged emission, when replacing the edited item is unsafe.
@@ -84,10 +94,14 @@ class SamplesEditor(ParamEditor):
                 for c, x in enumerate(pair):
                     item = self.table.item(r, c)
                     if item is None:
-                        self.table.setItem(r, c, QtWidgets.QTableWidgetItem(f"{x:.6g}"))
+                        self.table.setItem(r, c, QtWidgets.QTableWidgetItem(_cell_text(x)))
                     else:
-                        item.setText(f"{x:.6g}")
+                        item.setText(_cell_text(x))
         self._blocked([self.table], apply)
+
+
+def _cell_text(x: float) -> str:
+    return f"{x:.6g}"
 
 
 class JsonTextDialog(QtWidgets.QDialog):

@@ -1,5 +1,10 @@
 """The main window's files: new / open / example / save / export, autosave and
-crash recovery.  A bad file leaves the open project untouched."""
+crash recovery.  A bad file leaves the open project untouched.
+
+The window never writes into the shipped ``resources/`` folder: a shipped
+file (an example) always opens as an untitled copy, so Save asks for a path,
+and saving or exporting onto a path inside ``resources/`` is refused.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +16,18 @@ from engine.graph import GraphDocument, ProjectFileError, load_project, save_pro
 from engine.tiled_mesh import tiled_arrays
 
 from .dialogs import MESH_FILTERS
+
+SHIPPED_DIR = Path(__file__).resolve().parents[1] / "resources"
+"""The folder of files shipped with Mesoforge (examples, tile sets...): never written."""
+
+
+def is_shipped(path: str | Path) -> bool:
+    """Whether `path` lies inside the shipped resources folder (symlinks resolved)."""
+    try:
+        Path(path).resolve().relative_to(SHIPPED_DIR.resolve())
+    except ValueError:
+        return False
+    return True
 
 
 class WindowFiles:
@@ -70,6 +87,8 @@ class WindowFiles:
             if not path:
                 return False
         path = Path(path)
+        if is_shipped(path):
+            return self.open_example(path, ask=False)   # asked above; a shipped file is never the project
         try:
             new_doc = load_project(path)
         except ProjectFileError as exc:
@@ -101,17 +120,31 @@ class WindowFiles:
 
     def save_as(self, path: str | Path | None = None) -> bool:
         if path is None:
-            start = str(self.project_path) if self.project_path else str(Path.cwd() / "untitled.json")
+            start = str(self.project_path) if self.project_path else str(Path.cwd() / self._untitled_file_name())
             path = self.prompter.save_path("Save project as", start)
             if not path:
                 return False
         return self._write(Path(path))
+
+    def _untitled_file_name(self) -> str:
+        name = self.display_name.removesuffix(" (example)").strip()
+        return f"{name or 'untitled'}.json"
+
+    def _refuse_shipped(self, title: str, path: Path) -> bool:
+        """Show why `path` is not written and return True when it is inside resources/."""
+        if not is_shipped(path):
+            return False
+        self.show_error(title, f"cannot write {str(path)!r}: it is inside Mesoforge's shipped resources folder "
+                               f"({SHIPPED_DIR}), which is never overwritten; choose a path outside it")
+        return True
 
     def _take_node_state(self) -> None:
         """Put the evaluator's stateful-node results into the document before writing it."""
         self.doc.node_state = self.worker.evaluator.export_state()
 
     def _write(self, path: Path) -> bool:
+        if self._refuse_shipped("Cannot save project", path):
+            return False
         try:
             self._take_node_state()
             save_project(self.doc, path)
@@ -143,6 +176,8 @@ class WindowFiles:
         if path.suffix.lower() not in MESH_FILTERS.values():
             self.show_error("Export mesh", f"cannot export {str(path)!r}: expected a file ending in "
                                            f"{', '.join(MESH_FILTERS.values())}")
+            return False
+        if self._refuse_shipped("Export mesh", path):
             return False
         try:
             from engine.geometry.mesh_io import export_mesh
@@ -181,6 +216,8 @@ class WindowFiles:
                 self.show_error("Cannot recover", str(exc))
             else:
                 path = Path(item.original_path) if item.original_path else None
+                if path is not None and is_shipped(path):
+                    path = None                      # an example's copy: Save asks where
                 self._replace_document(new_doc, path, path.name if path else "recovered")
                 self._dirty_without_undo = True
                 self._update_title()

@@ -6,6 +6,8 @@ from pathlib import Path
 
 from PySide6 import QtGui
 
+from .undo_keys import REDO_KEYS, UNDO_KEYS, UndoKeys
+
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "resources" / "examples"
 
 
@@ -36,6 +38,12 @@ class WindowMenus:
         self.act_quit = self._action("&Quit", self.close, K.Quit)
         self.act_undo = self._action("&Undo", self.undo_edit, K.Undo)
         self.act_redo = self._action("&Redo", self.redo_edit, K.Redo)
+        # Ctrl+Z, Ctrl+Shift+Z and Ctrl+Y from any widget of the window and its docks (a window
+        # shortcut also fires in a floating dock); in text fields, which claim them for their own
+        # text undo, through UndoKeys
+        self.act_undo.setShortcuts(list(UNDO_KEYS))
+        self.act_redo.setShortcuts(list(REDO_KEYS))
+        self.undo_keys = UndoKeys(self, self.undo_edit, self.redo_edit)
         self.act_delete = self._action("&Delete Node", self.editor.delete_selected, K.Delete)
         self.act_tiling = self._action("Tile 3×3×3", lambda on: self.viewport.set_tiling(3 if on else 1),
                                        "T", checkable=True)
