@@ -83,6 +83,8 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
         self._autosave_timer.start()
 
         self.doc.subscribe(self._on_doc_event)
+        self.doc.subscribe(self._on_doc_event_overlays)
+        self.viewport.overlay_owner = self._overlay_owner
         self.undo.subscribe(self._on_undo_changed)
         self.worker.started.connect(self._on_eval_started)
         self.worker.progress.connect(self._on_eval_progress)
@@ -169,9 +171,26 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
         self.growth_panel.set_context(self.doc, outputs, sel)
         self.phasor_panel.set_context(self.doc, outputs, sel)
         self.rd_panel.set_context(self.doc, outputs, sel)
+        self.viewport.drop_overlays(self._owns_overlay)
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
                                   skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
                                   sphere_caption=sphere_caption)
+
+    def _overlay_owner(self):
+        """Owner of a new viewport overlay (the Phasor dock's toolpaths): this document and
+        the dock's node."""
+        return (self._generation, self.phasor_panel.noise_id or self.phasor_panel.fields_id)
+
+    def _owns_overlay(self, owner) -> bool:
+        """An overlay stays while its document is open and its node is in it."""
+        if not isinstance(owner, tuple) or len(owner) != 2:
+            return owner is None
+        generation, node_id = owner
+        return generation == self._generation and (node_id is None or node_id in self.doc.nodes)
+
+    def _on_doc_event_overlays(self, event: str, payload) -> None:
+        if event in ("node_removed", "reset"):
+            self.viewport.drop_overlays(self._owns_overlay)
 
     def current_solid(self) -> Solid | None:
         return self.viewport.solid

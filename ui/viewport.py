@@ -1,169 +1,54 @@
 """3D viewport: the current solid (optionally tiled 3x3x3), its skeleton and the unit cell.
 
-A thin adapter over a pyvistaqt `QtInteractor`; everything here runs on the
-GUI thread.  `pick_display_nodes` decides, from an evaluation's outputs,
-which node's solid and which skeleton to show, and `pick_stiffness_node`
-which Material Matrix result gets its material sphere (paper Fig. 11c)
-drawn beside the cell block; both are plain Python.
+A thin adapter over a pyvistaqt `QtInteractor`.  The scene is kept by actor
+(`ui.scene.SceneActors`): a new state replaces only the actors whose value
+changed, so selecting another node that shows the same solid touches
+nothing.  A solid's render mesh (normals, the merged 3x3x3 tiling) is
+prepared off the GUI thread in a `TaskRunner` (`ui.scene_prep`) and kept per
+solid and tiling; the GUI thread only swaps it into the actor.  What to show
+is decided by the plain functions of `ui.view_content`, re-exported here.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Callable
 
 import numpy as np
 import pyvista as pv
 from pyvistaqt import QtInteractor
-from PySide6 import QtWidgets
+from PySide6 import QtCore, QtWidgets
 
 from engine.fab import vtk_line_cells
-from engine.graph import GraphDocument
-from engine.graph.query import nearest_upstream, pick_node, type_of
-from engine.geometry.values import Skeleton, Solid, VoxelModel
+from engine.geometry.values import Skeleton, Solid
 from engine.physics.values import Stiffness
-from engine.physics.material_sphere import material_polar, material_sphere_polydata
 
-SOLID_COLOUR = "#d8cfc0"
-LINE_COLOUR = "#4696dc"
-POINT_COLOUR = "#e8b03c"
-SURFACE_COLOUR = "#6aa8e0"
-BOX_COLOUR = "#8a9099"
-SPHERE_SUBDIVISIONS = 4      # icosphere: 10 * 4**4 + 2 = 2562 directions
-SPHERE_RADIUS = 0.5          # largest radius, as a fraction of the cell block's edge
-SPHERE_GAP = 0.3             # free space between block and sphere, same unit
-SPHERE_CMAP = "viridis"
-SPHERE_BAR_TITLE = "E(d)"
+from .qt_wait import process_events_until
+from .scene import MIN_FRAMED_PIXELS, Framing, SceneActors
+from .scene_prep import cell_for_tiling, prepare_cell, skeleton_polydata, surfaces_polydata, tiled_polydata
+from .task_runner import TaskRunner
+from .view_content import (BOX_COLOUR, LINE_COLOUR, POINT_COLOUR, SOLID_COLOUR, SPHERE_BAR_TITLE, SPHERE_CMAP,
+                           SPHERE_GAP, SPHERE_RADIUS, SPHERE_SUBDIVISIONS, SURFACE_COLOUR, block_bounds,
+                           material_polar_polydata, pick_display_nodes, pick_stiffness_node, polydata,
+                           skeleton_of, solid_of, sphere_placement, stiffness_of, stiffness_polydata,
+                           tile_offsets, tiled_arrays)
 
+__all__ = ["Viewport", "block_bounds", "material_polar_polydata", "pick_display_nodes", "pick_stiffness_node",
+           "polydata", "skeleton_of", "solid_of", "sphere_placement", "stiffness_of", "tile_offsets",
+           "tiled_arrays", "BOX_COLOUR", "LINE_COLOUR", "POINT_COLOUR", "SOLID_COLOUR", "SURFACE_COLOUR",
+           "SPHERE_BAR_TITLE", "SPHERE_CMAP", "SPHERE_GAP", "SPHERE_RADIUS", "SPHERE_SUBDIVISIONS"]
 
-# -- what to show ------------------------------------------------------------------
-def solid_of(outputs: dict) -> Solid | None:
-    """The Solid among a node's outputs (a VoxelModel carries one too)."""
-    for value in outputs.values():
-        if isinstance(value, Solid):
-            return value
-    for value in outputs.values():
-        if isinstance(value, VoxelModel):
-            return value.solid
-    return None
-
-
-def skeleton_of(outputs: dict) -> Skeleton | None:
-    for value in outputs.values():
-        if isinstance(value, Skeleton):
-            return value
-    return None
-
-
-def _has(outputs: dict, value_of):
-    """An ``accept`` predicate for ``engine.graph.query``: the node's outputs hold a value ``value_of`` finds."""
-    return lambda nid: nid in outputs and value_of(outputs[nid]) is not None
-
-
-def pick_display_nodes(doc: GraphDocument, outputs: dict, selected: str | None = None
-                       ) -> tuple[str | None, str | None]:
-    """(solid node id, skeleton node id) to display.
-
-    The selected node's solid if it has one; otherwise the solid feeding the
-    Voxel node, else the last solid in topological order (a Voxel node's
-    solid is only shown when it is selected).  The skeleton is the selected
-    node's if it is a skeleton node, else the nearest skeleton above the
-    shown solid.  Plain calls of ``engine.graph.query``.
-    """
-    outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
-    has_solid, has_skeleton = _has(outputs, solid_of), _has(outputs, skeleton_of)
-    solid_id = skel_id = None
-    if selected is not None and has_solid(selected):
-        solid_id = selected
-    elif selected is not None and has_skeleton(selected):
-        skel_id = selected
-    if solid_id is None:
-        voxel = next((nid for nid, node in doc.nodes.items() if node.type_name == "Voxel"), None)
-        feeder = nearest_upstream(doc, voxel, lambda _nid: True) if voxel is not None else None
-        if feeder is not None and has_solid(feeder):
-            solid_id = feeder
-        else:
-            solid_id = pick_node(doc, None, lambda nid: has_solid(nid) and type_of(doc, nid) != "Voxel")
-    if skel_id is None and solid_id is not None:
-        skel_id = nearest_upstream(doc, solid_id, has_skeleton)
-    return solid_id, skel_id
-
-
-def stiffness_of(outputs: dict) -> Stiffness | None:
-    """The Stiffness among a node's outputs: 3D (6x6, drawn as the material
-    sphere) or 2D plane stress (3x3, drawn as its polar curve E(theta))."""
-    for value in outputs.values():
-        if isinstance(value, Stiffness) and np.shape(value.C) in ((6, 6), (3, 3)):
-            return value
-    return None
-
-
-def material_polar_polydata(C2d: np.ndarray, n: int = 360) -> pv.PolyData:
-    """The 2D counterpart of the material sphere: the closed curve E(theta) (1, cos, sin)
-    in the z = 0 plane, with point array "E"."""
-    theta, E = material_polar(C2d, n=n)
-    pts = np.column_stack([E * np.cos(theta), E * np.sin(theta), np.zeros_like(theta)])
-    curve = pv.lines_from_points(np.vstack([pts, pts[:1]]))
-    curve["E"] = np.append(E, E[0])
-    return curve
-
-
-def pick_stiffness_node(doc: GraphDocument, outputs: dict, selected: str | None = None) -> str | None:
-    """Node whose material sphere to draw, by ``engine.graph.query.pick_node``:
-    the selected node if it produced a Stiffness, else the nearest such node
-    above it, else the last such node in topological order (None if none did)."""
-    outputs = {k: v for k, v in outputs.items() if k in doc.nodes}
-    return pick_node(doc, selected, _has(outputs, stiffness_of))
-
-
-# -- geometry helpers ------------------------------------------------------------------
-def tile_offsets(tiles: int, cell_size) -> np.ndarray:
-    """(tiles**3, 3) translations placing the original cell in the middle.
-
-    cell_size : float (a cube's edge) or (3,) the cell box's edges (``Solid.box``)."""
-    r = np.arange(tiles) - (tiles - 1) // 2
-    grid = np.stack(np.meshgrid(r, r, r, indexing="ij"), axis=-1).reshape(-1, 3)
-    return grid.astype(float) * (cell_size if np.ndim(cell_size) == 0 else np.asarray(cell_size, float))
-
-
-def tiled_arrays(vertices: np.ndarray, faces: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Translated copies of one mesh, concatenated: ((k*n, 3), (k*m, 3))."""
-    n = len(vertices)
-    v = (vertices[None, :, :] + offsets[:, None, :]).reshape(-1, 3)
-    f = (faces[None, :, :] + (np.arange(len(offsets)) * n)[:, None, None]).reshape(-1, 3)
-    return v, f
-
-
-def block_bounds(tiles: int, cell_size):
-    """(lo, hi) of the block of `tiles`**3 cells drawn by the viewport: floats
-    (every axis) for a cube's edge `cell_size`, (3,) arrays for a box's edges."""
-    if np.ndim(cell_size) != 0:
-        box = np.asarray(cell_size, dtype=float)
-        lo = -box * ((tiles - 1) // 2)
-        return lo, lo + tiles * box
-    lo = -cell_size * ((tiles - 1) // 2)
-    return lo, lo + tiles * cell_size
-
-
-def sphere_placement(tiles: int, cell_size, max_radius: float) -> tuple[float, np.ndarray]:
-    """(scale, centre) putting a surface of largest radius `max_radius` to the
-    right (+x) of the cell block, its largest radius `SPHERE_RADIUS` of the
-    block's longest edge (`cell_size`: a cube's edge or a box's three edges)."""
-    lo, hi = (np.broadcast_to(np.asarray(b, dtype=float), (3,)) for b in block_bounds(tiles, cell_size))
-    edge = float((hi - lo).max())
-    radius = SPHERE_RADIUS * edge
-    scale = radius / max_radius if max_radius > 0 else 1.0
-    mid = 0.5 * (lo + hi)
-    return scale, np.array([hi[0] + SPHERE_GAP * edge + radius, mid[1], mid[2]])
-
-
-def polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
-    faces = np.asarray(faces, dtype=np.int64)
-    cells = np.hstack([np.full((len(faces), 1), 3, dtype=np.int64), faces]).ravel()
-    return pv.PolyData(np.asarray(vertices, dtype=float), cells)
+HINT = "nothing to show yet: evaluate a graph with a solid or skeleton node"
+SKELETON_ACTORS = ("skeleton_lines", "skeleton_surfaces", "control_points")
 
 
 class Viewport(QtWidgets.QWidget):
-    """Shows a Solid (tiled 1x1x1 or 3x3x3), a Skeleton and the unit-cell box."""
+    """Shows a Solid (tiled 1x1x1 or 3x3x3), a Skeleton, the unit-cell box, a
+    material sphere and overlays (toolpaths) owned by the node that made them.
+
+    Signals: ``scene_ready()`` once a prepared solid mesh is in its actor."""
+
+    scene_ready = QtCore.Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -171,25 +56,35 @@ class Viewport(QtWidgets.QWidget):
         layout.setContentsMargins(0, 0, 0, 0)
         self.plotter = QtInteractor(self)
         layout.addWidget(self.plotter.interactor)
+        # 4x MSAA triples the software renderer's frame time; lines are drawn as tubes anyway
+        self.plotter.render_window.SetMultiSamples(0)
         self.plotter.set_background("#1d1f23", top="#3a3f47")
         self.plotter.add_axes(color="white")
+        self.scene = SceneActors(self.plotter)
+        self.framing = Framing()
         self.tiles = 1
         self.show_skeleton = True
         self.show_solid = True
+        self.show_sphere = True
         self.solid: Solid | None = None
         self.skeleton: Skeleton | None = None
         self.stiffness: Stiffness | None = None
+        self.caption = ""
         self.sphere_caption = ""
-        self.show_sphere = True
-        self._sphere_cache: tuple[bytes, pv.PolyData] | None = None
+        self.skeleton_emphasis = False
+        self.toolpaths: pv.PolyData | None = None
+        self.toolpath_owner: Any = None
+        self.overlay_owner: Callable[[], Any] | None = None  # who owns a new overlay (set by the window)
+        self.prepared = 0                 # solid meshes prepared (off the GUI thread)
+        self._failed: tuple | None = None    # the (solid, tiles) whose preparation failed
+        self._closed = False
         self._sphere_points = 0
         self._sphere_note = ""
-        self.caption = ""
-        self.skeleton_emphasis = False
-        self._shown_points = 0
-        self._camera_key = None
-        self._closed = False
-        self.toolpaths: pv.PolyData | None = None
+        self._wanted_solid: tuple | None = None         # (solid, tiles) the solid actor should show
+        self._mesh_cache: tuple[Solid | None, Any, dict] = (None, None, {})  # solid, PreparedCell, {tiles: mesh}
+        self._prep = TaskRunner(self)
+        self._prep.finished.connect(self._on_prepared)
+        self._prep.failed.connect(self._on_prep_failed)
         self.redraw()
 
     # -- state --------------------------------------------------------------------
@@ -197,7 +92,8 @@ class Viewport(QtWidgets.QWidget):
                     *, skeleton_emphasis: bool = False, stiffness: Stiffness | None = None,
                     sphere_caption: str = "") -> None:
         """Display `solid`, `skeleton` and the material sphere of `stiffness` (any may be None);
-        `sphere_caption` joins the caption while the sphere is drawn.  Re-renders."""
+        `sphere_caption` joins the caption while the sphere is drawn.  Only changed actors
+        are replaced; a new solid mesh is prepared off the GUI thread."""
         self.solid, self.skeleton, self.caption = solid, skeleton, caption
         self.skeleton_emphasis = skeleton_emphasis
         self.stiffness, self.sphere_caption = stiffness, sphere_caption
@@ -221,9 +117,10 @@ class Viewport(QtWidgets.QWidget):
         self.show_sphere = bool(on)
         self.redraw()
 
-    def show_toolpaths(self, points, segments, colours) -> None:
+    def show_toolpaths(self, points, segments, colours, owner: Any = None) -> None:
         """Print preview: line segments (m, 2) between `points` (n, 3) mm, each
-        coloured by `colours` (m, 3) uint8 (perimeter, infill, travel...)."""
+        coloured by `colours` (m, 3) uint8 (perimeter, infill, travel...).  The
+        overlay belongs to `owner` (default: ``overlay_owner()``), see `drop_overlays`."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         segments = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
         if not len(segments):
@@ -232,11 +129,18 @@ class Viewport(QtWidgets.QWidget):
         lines = pv.PolyData(points, lines=vtk_line_cells(segments))
         lines.cell_data["rgb"] = np.asarray(colours, dtype=np.uint8).reshape(-1, 3)
         self.toolpaths = lines
+        self.toolpath_owner = owner if owner is not None or self.overlay_owner is None else self.overlay_owner()
         self.redraw()
 
     def clear_toolpaths(self) -> None:
-        self.toolpaths = None
+        self.toolpaths, self.toolpath_owner = None, None
         self.redraw()
+
+    def drop_overlays(self, keep: Callable[[Any], bool]) -> None:
+        """Remove the overlays whose owner ``keep(owner)`` refuses (its node went, another
+        document opened)."""
+        if self.toolpaths is not None and not keep(self.toolpath_owner):
+            self.clear_toolpaths()
 
     def toolpath_segment_count(self) -> int:
         return 0 if self.toolpaths is None else int(self.toolpaths.n_cells)
@@ -246,8 +150,16 @@ class Viewport(QtWidgets.QWidget):
         return self._sphere_points
 
     def mesh_point_count(self) -> int:
-        """Number of solid-mesh points currently shown (all tiles)."""
-        return self._shown_points
+        """Number of solid-mesh points the view shows (all tiles), counting a mesh
+        still being prepared; `shown_mesh_point_count` is what the actor holds now."""
+        if self._wanted_solid is None:
+            return 0
+        solid, tiles = self._wanted_solid
+        return len(solid.vertices) * tiles ** 3
+
+    def shown_mesh_point_count(self) -> int:
+        actor = self.scene.actor("solid")
+        return 0 if actor is None else int(actor.GetMapper().GetInput().GetNumberOfPoints())
 
     def cell_size(self) -> float:
         return float(self.solid.cell_size) if self.solid is not None else 1.0
@@ -256,57 +168,219 @@ class Viewport(QtWidgets.QWidget):
         """(3,) mm, the edges of one tile (the solid's box; a unit cube without a solid)."""
         return self.solid.box if self.solid is not None else np.ones(3)
 
+    @property
+    def is_ready(self) -> bool:
+        """Nothing is being prepared and the solid actor shows what it should."""
+        wanted = self._wanted_solid
+        return not self._prep.is_busy and (wanted is None or self.scene.same("solid", wanted)
+                                           or _same(wanted, self._failed))
+
+    def wait_ready(self, timeout_ms: int = 60000) -> bool:
+        """Process events until `is_ready` (tests, screenshots)."""
+        return process_events_until(lambda: self._closed or self.is_ready, lambda: None, timeout_ms=timeout_ms)
+
     # -- drawing --------------------------------------------------------------------
     def redraw(self) -> None:
+        """Bring the actors in line with the state; render once if anything changed."""
         if self._closed:
             return
-        # Every add_mesh would render the window once (~0.1 s each in software
-        # GL); build the whole scene first and render it once.
         self.plotter.suppress_rendering = True
         try:
-            self._build_scene()
+            changed = self._sync_scene()
         finally:
             self.plotter.suppress_rendering = False
-        self.plotter.render()
+        if self._frame() or changed:
+            self.plotter.render()
 
-    def _build_scene(self) -> None:
-        p = self.plotter
-        if SPHERE_BAR_TITLE in p.scalar_bars:
-            p.remove_scalar_bar(SPHERE_BAR_TITLE)  # clear_actors can leave a bar whose mapper was replaced
-        p.clear_actors()
-        self._shown_points = 0
-        self._sphere_points = 0
-        self._sphere_note = ""
-        c = self.cell_size()
+    def _sync_scene(self) -> bool:
         box = self.cell_box()
-        tileable = self.solid is None or self.solid.periodic
-        offsets = tile_offsets(self.tiles if tileable else 1, box)
-        if self.show_solid and self.solid is not None and len(self.solid.faces):
-            v, f = tiled_arrays(self.solid.vertices, self.solid.faces, offsets)
-            mesh = polydata(v, f)
-            translucent = self.show_skeleton and self.skeleton is not None and self.skeleton_emphasis
-            p.add_mesh(mesh, color=SOLID_COLOUR, smooth_shading=True, specular=0.25, name="solid",
-                       opacity=0.35 if translucent else 1.0)
-            self._shown_points = int(mesh.n_points)
-        if self.show_skeleton and self.skeleton is not None:
-            self._draw_skeleton(self.skeleton, c)
-        self._draw_cell_boxes(box)
-        if self.show_sphere and self.stiffness is not None:
-            self._draw_material_sphere(self.stiffness, box)
-        if self.toolpaths is not None:
-            p.add_mesh(self.toolpaths, scalars="rgb", rgb=True, line_width=1.5, name="toolpaths")
+        tiles = self.tiles if self.solid is None or self.solid.periodic else 1
+        changed = self._sync_solid(tiles)
+        changed |= self._sync_skeleton()
+        changed |= self._sync_boxes(box)
+        changed |= self._sync_sphere(box)
+        if self.toolpaths is None:
+            changed |= self.scene.drop("toolpaths")
+        else:
+            changed |= self.scene.put("toolpaths", (self.toolpaths,), lambda: self.plotter.add_mesh(
+                self.toolpaths, scalars="rgb", rgb=True, line_width=1.5, name="toolpaths", reset_camera=False))
         sphere_line = self.sphere_caption if self._sphere_points else self._sphere_note
-        caption = "\n".join(t for t in (self.caption, sphere_line) if t)
-        if caption:
-            p.add_text(caption, position="upper_left", font_size=9, color="white", name="caption")
-        if self.solid is None and self.skeleton is None and self.toolpaths is None:
-            p.add_text("nothing to show yet: evaluate a graph with a solid or skeleton node",
-                       position="lower_left", font_size=9, color="#9aa0a6", name="hint")
-        key = (self.tiles, tuple(np.round(box, 9)), self._sphere_points > 0,
-               None if self.toolpaths is None else tuple(np.round(self.toolpaths.bounds, 3)))
-        if key != self._camera_key:
-            self._camera_key = key
-            self._home_camera()
+        changed |= self._put_text("caption", "\n".join(t for t in (self.caption, sphere_line) if t), "upper_left",
+                                  "white")
+        empty = self.solid is None and self.skeleton is None and self.toolpaths is None
+        changed |= self._put_text("hint", HINT if empty else "", "lower_left", "#9aa0a6")
+        return changed
+
+    def _put_text(self, name: str, text: str, position: str, colour: str) -> bool:
+        if not text:
+            return self.scene.drop(name)
+        return self.scene.put(name, (text,), lambda: self.plotter.add_text(
+            text, position=position, font_size=9, color=colour, name=name))
+
+    def _sync_solid(self, tiles: int) -> bool:
+        solid = self.solid
+        if not (self.show_solid and solid is not None and len(solid.faces)):
+            self._wanted_solid = None
+            self._prep.cancel()
+            return self.scene.drop("solid")
+        key = (solid, tiles)
+        self._wanted_solid = key
+        if self.scene.same("solid", key):
+            return self._set_solid_opacity()
+        cached, cell, meshes = self._mesh_cache
+        if cached is solid and tiles in meshes:
+            self._prep.cancel()
+            self._swap_solid(key, meshes[tiles])
+            return True
+        if _same(key, self._failed):
+            return False
+        running = self._prep.running
+        if running is not None and _same(running.data, key) and self._prep.pending is None:
+            return False
+        cell = cell if cached is solid else None
+        offsets = tile_offsets(tiles, solid.box)
+        self._prep.submit(lambda task: _prepare_solid(task, solid, cell, offsets), data=key)
+        return False
+
+    def _set_solid_opacity(self) -> bool:
+        actor = self.scene.actor("solid")
+        if actor is None:
+            return False
+        translucent = self.show_skeleton and self.skeleton is not None and self.skeleton_emphasis
+        opacity = 0.35 if translucent else 1.0
+        if actor.prop.opacity == opacity:
+            return False
+        actor.prop.opacity = opacity
+        return True
+
+    def _swap_solid(self, key: tuple, mesh: pv.PolyData) -> None:
+        """Show the prepared `mesh`: a new input for the existing actor (cheap), or the first actor."""
+        actor = self.scene.actor("solid")
+
+        def build():
+            if actor is not None:
+                actor.mapper.SetInputData(mesh)
+                return actor
+            new = self.plotter.add_mesh(mesh, color=SOLID_COLOUR, specular=0.25, name="solid",
+                                        reset_camera=False)
+            new.prop.interpolation = "phong"   # the prepared point normals give smooth shading
+            return new
+
+        self.scene.put("solid", key, build)
+        self._set_solid_opacity()
+
+    def _on_prepared(self, task, result) -> None:
+        if self._closed:
+            return
+        solid, tiles = task.data
+        cell, mesh = result
+        self.prepared += 1
+        cached, _, meshes = self._mesh_cache
+        if cached is not solid:
+            meshes = {}
+        meshes[tiles] = mesh
+        self._mesh_cache = (solid, cell, meshes)
+        if _same(task.data, self._wanted_solid):
+            self._swap_solid(task.data, mesh)
+            self._frame()
+            self.plotter.render()
+            self.scene_ready.emit()
+
+    def _on_prep_failed(self, task, message: str) -> None:
+        self._failed = task.data
+        self.caption = f"{self.caption}\nsolid not drawn: {message}".strip()
+        self.redraw()
+
+    def _sync_skeleton(self) -> bool:
+        skeleton = self.skeleton if self.show_skeleton else None
+        if skeleton is None:
+            return any([self.scene.drop(name) for name in SKELETON_ACTORS])
+        c = self.cell_size()
+        key = (skeleton, c)
+        if self.scene.same("skeleton_lines", key):
+            return False
+        lines = skeleton_polydata([line.polyline * c for line in skeleton.lines])
+        surfaces = surfaces_polydata([(s.vertices * c, s.faces) for s in skeleton.surfaces])
+        controls = [line.control_points * c for line in skeleton.lines]
+        points = np.concatenate(controls) if controls else np.zeros((0, 3))
+        add = self.plotter.add_mesh
+        for name, mesh, style in (
+                ("skeleton_lines", lines, dict(color=LINE_COLOUR, line_width=4, render_lines_as_tubes=True)),
+                ("skeleton_surfaces", surfaces, dict(color=SURFACE_COLOUR, opacity=0.6)),
+                ("control_points", pv.PolyData(points) if len(points) else None,
+                 dict(color=POINT_COLOUR, point_size=12, render_points_as_spheres=True))):
+            self.scene.drop(name)
+            self.scene.put(name, key, lambda m=mesh, n=name, s=style:
+                           None if m is None else add(m, name=n, reset_camera=False, **s))
+        return True
+
+    def _sync_boxes(self, box: np.ndarray) -> bool:
+        bx, by, bz = (float(v) for v in box)
+        changed = self.scene.put("cell_box", (bx, by, bz), lambda: self.plotter.add_mesh(
+            pv.Box(bounds=(0, bx, 0, by, 0, bz)), style="wireframe", color=BOX_COLOUR, line_width=1.5,
+            name="cell_box", reset_camera=False))
+        if self.tiles == 1:
+            return self.scene.drop("tiling_box") or changed
+        lo, hi = block_bounds(self.tiles, box)
+        return self.scene.put("tiling_box", (bx, by, bz, self.tiles), lambda: self.plotter.add_mesh(
+            pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])), style="wireframe", color="#5a6068",
+            line_width=1.0, name="tiling_box", reset_camera=False)) or changed
+
+    def _sync_sphere(self, box: np.ndarray) -> bool:
+        if not (self.show_sphere and self.stiffness is not None):
+            self._sphere_points, self._sphere_note = 0, ""
+            return self._drop_sphere()
+        C = np.ascontiguousarray(self.stiffness.C)
+        key = (C.tobytes(), self.tiles, tuple(float(v) for v in box))
+        if self.scene.same("material_sphere", key):
+            return False
+        self._drop_sphere()
+        self.scene.put("material_sphere", key, lambda: self._draw_material_sphere(C, box))
+        return True
+
+    def _drop_sphere(self) -> bool:
+        if SPHERE_BAR_TITLE in self.plotter.scalar_bars:
+            self.plotter.remove_scalar_bar(SPHERE_BAR_TITLE)
+        return self.scene.drop("material_sphere")
+
+    def _draw_material_sphere(self, C: np.ndarray, box: np.ndarray):
+        self._sphere_points, self._sphere_note = 0, ""
+        try:
+            base = stiffness_polydata(C)
+        except ValueError:
+            self._sphere_note = "material sphere: none, C is singular (the cell is a mechanism)"
+            return None
+        radii = np.linalg.norm(base.points, axis=1)
+        scale, centre = sphere_placement(self.tiles, box, float(radii.max()))
+        mesh = base.copy()
+        mesh.points = base.points * scale + centre
+        curve = {"line_width": 5, "render_lines_as_tubes": True} if mesh.n_lines else {}
+        actor = self.plotter.add_mesh(
+            mesh, scalars="E", cmap=SPHERE_CMAP, smooth_shading=True, specular=0.2, name="material_sphere",
+            reset_camera=False, **curve,
+            scalar_bar_args={"title": SPHERE_BAR_TITLE, "vertical": False, "position_x": 0.55, "position_y": 0.04,
+                             "width": 0.4, "height": 0.07, "n_labels": 4, "color": "white", "fmt": "%.3g",
+                             "title_font_size": 14, "label_font_size": 11})
+        self._sphere_points = int(mesh.n_points)
+        return actor
+
+    # -- camera ------------------------------------------------------------------------
+    def _has_content(self) -> bool:
+        return any(self.scene.actor(n) is not None for n in ("solid", "toolpaths", *SKELETON_ACTORS))
+
+    def _sized(self) -> bool:
+        w = self.plotter.interactor
+        return self.isVisible() and min(w.width(), w.height()) >= MIN_FRAMED_PIXELS
+
+    def _frame(self) -> bool:
+        """Home the camera if `Framing` asks for it; True if it did."""
+        bounds = self.plotter.renderer.ComputeVisiblePropBounds()
+        content = self._has_content()
+        if not self.framing.wants_home(bounds, has_content=content, sized=self._sized()):
+            return False
+        self._home_camera()
+        self.framing.homed(bounds, has_content=content)
+        return True
 
     def _home_camera(self) -> None:
         # Slightly off the cube diagonal: the exact isometric view hides
@@ -314,77 +388,47 @@ class Viewport(QtWidgets.QWidget):
         self.plotter.view_vector((1.0, -1.7, 0.8), viewup=(0.0, 0.0, 1.0))
         self.plotter.reset_camera()
 
-    def _draw_skeleton(self, skeleton: Skeleton, c: float) -> None:
-        p = self.plotter
-        controls = []
-        for i, line in enumerate(skeleton.lines):
-            if len(line.polyline) >= 2:
-                p.add_mesh(pv.lines_from_points(line.polyline * c), color=LINE_COLOUR, line_width=4,
-                           render_lines_as_tubes=True, name=f"line{i}")
-            controls.append(line.control_points * c)
-        for i, surf in enumerate(skeleton.surfaces):
-            if len(surf.faces):
-                p.add_mesh(polydata(surf.vertices * c, surf.faces), color=SURFACE_COLOUR, opacity=0.6,
-                           name=f"surface{i}")
-        if controls:
-            pts = np.concatenate(controls)
-            if len(pts):
-                p.add_mesh(pv.PolyData(pts), color=POINT_COLOUR, point_size=12,
-                           render_points_as_spheres=True, name="control_points")
-
-    def _draw_cell_boxes(self, box: np.ndarray) -> None:
-        bx, by, bz = (float(v) for v in box)
-        self.plotter.add_mesh(pv.Box(bounds=(0, bx, 0, by, 0, bz)), style="wireframe", color=BOX_COLOUR,
-                              line_width=1.5, name="cell_box")
-        if self.tiles > 1:
-            lo, hi = block_bounds(self.tiles, box)
-            self.plotter.add_mesh(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])), style="wireframe",
-                                  color="#5a6068", line_width=1.0, name="tiling_box")
-
-    def _sphere_mesh(self, stiffness: Stiffness) -> pv.PolyData:
-        """The unscaled material sphere, recomputed only when C changes."""
-        key = np.ascontiguousarray(stiffness.C).tobytes()
-        if self._sphere_cache is None or self._sphere_cache[0] != key:
-            if np.shape(stiffness.C) == (3, 3):
-                mesh = material_polar_polydata(stiffness.C)
-            else:
-                mesh = material_sphere_polydata(stiffness.C, subdivisions=SPHERE_SUBDIVISIONS)
-            self._sphere_cache = (key, mesh)
-        return self._sphere_cache[1]
-
-    def _draw_material_sphere(self, stiffness: Stiffness, box: np.ndarray) -> None:
-        try:
-            base = self._sphere_mesh(stiffness)
-        except ValueError:
-            self._sphere_note = "material sphere: none, C is singular (the cell is a mechanism)"
-            return
-        radii = np.linalg.norm(base.points, axis=1)
-        scale, centre = sphere_placement(self.tiles, box, float(radii.max()))
-        mesh = base.copy()
-        mesh.points = base.points * scale + centre
-        curve = {"line_width": 5, "render_lines_as_tubes": True} if mesh.n_lines else {}
-        self.plotter.add_mesh(
-            mesh, scalars="E", cmap=SPHERE_CMAP, smooth_shading=True, specular=0.2, name="material_sphere", **curve,
-            scalar_bar_args={"title": SPHERE_BAR_TITLE, "vertical": False, "position_x": 0.55, "position_y": 0.04,
-                             "width": 0.4, "height": 0.07, "n_labels": 4, "color": "white", "fmt": "%.3g",
-                             "title_font_size": 14, "label_font_size": 11})
-        self._sphere_points = int(mesh.n_points)
-
     def reset_camera(self) -> None:
         self._home_camera()
+        self.framing.homed(self.plotter.renderer.ComputeVisiblePropBounds(), has_content=self._has_content())
         self.plotter.render()
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        QtCore.QTimer.singleShot(0, self._frame_when_sized)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        QtCore.QTimer.singleShot(0, self._frame_when_sized)
+
+    def _frame_when_sized(self) -> None:
+        if not self._closed and self._frame():
+            self.plotter.render()
 
     # -- output -------------------------------------------------------------------------
     def save_screenshot(self, path: str | Path) -> Path:
-        """Render and write the view as a PNG; returns the path."""
+        """Render and write the view as a PNG (once the prepared solid is in); returns the path."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
+        self.wait_ready()
         self.plotter.render()
         self.plotter.screenshot(str(path))
         return path
 
     def close_plotter(self) -> None:
-        """Release the render window (must happen before the widget goes)."""
+        """Stop the preparation thread and release the render window (must happen before the widget goes)."""
         if not self._closed:
             self._closed = True
+            self._prep.shutdown()
             self.plotter.close()
+
+
+def _same(a, b) -> bool:
+    return a is not None and b is not None and a[0] is b[0] and a[1] == b[1]
+
+
+def _prepare_solid(task, solid: Solid, cell, offsets: np.ndarray):
+    """Worker thread: (PreparedCell, tiled PolyData) of `solid` at `offsets`."""
+    cell = cell if cell is not None else prepare_cell(solid.vertices, solid.faces)
+    task.check()
+    return cell, tiled_polydata(cell_for_tiling(cell, len(offsets)), offsets, check=task.check)

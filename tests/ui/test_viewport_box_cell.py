@@ -43,6 +43,7 @@ def test_viewport_tiles_a_box_solid(qtbot):
         view.show_result(solid, None)
         view.set_tiling(3)
         assert view.mesh_point_count() == 27 * len(v)
+        assert view.wait_ready()                      # the tiled mesh is prepared off the GUI thread
         bounds = view.plotter.renderer.actors["solid"].GetBounds()
         lo, hi = block_bounds(3, 2.0 * BOX)
         assert bounds[2] == pytest.approx(lo[1]) and bounds[3] == pytest.approx(hi[1])

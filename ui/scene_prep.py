@@ -1,0 +1,122 @@
+"""Mesh preparation for the 3D viewport, run off the GUI thread.
+
+Plain functions (numpy + pyvista data objects, no Qt, no render window), so a
+`ui.task_runner.TaskRunner` can run them in a worker thread: the GUI thread
+then only swaps the finished `pyvista.PolyData` into its actor.
+
+Smooth shading needs point normals.  They are computed once per solid, on the
+single cell, with numpy (area-weighted face normals summed at each vertex),
+and a 3x3x3 tiling reuses them: a translated copy has the same normals, and
+the tiled mesh does not merge vertices across tile seams, so these are
+exactly the normals a normals filter would compute on the merged mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pyvista as pv
+
+# rows per chunk of the tiling copy: numpy releases the GIL on big copies,
+# and chunks let a superseded preparation stop early
+TILE_CHUNK = 4
+# a tiled view draws at most about this many triangles: finer cells are
+# decimated for the tiling (the software renderer spends ~0.3 us a triangle;
+# at 3x3x3 a cell spans ~100 pixels, so the full mesh is far below a pixel)
+TILED_TRIANGLE_BUDGET = 400_000
+
+
+@dataclass(frozen=True)
+class PreparedCell:
+    """One cell's mesh ready to tile: vertices (n, 3) float32 mm, faces (m, 3)
+    int64, unit point normals (n, 3) float32."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray
+
+
+def point_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(n, 3) float32 unit normals at the vertices: the area-weighted sum of the
+    normals of the triangles around each vertex (zero for a vertex no triangle uses)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if not len(f):
+        return np.zeros((len(v), 3), np.float32)
+    face_n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])  # |n| = 2 * area
+    acc = np.zeros((len(v), 3))
+    for axis in range(3):
+        w = np.repeat(face_n[:, axis], 3)
+        acc[:, axis] = np.bincount(f.ravel(), weights=w, minlength=len(v))
+    length = np.linalg.norm(acc, axis=1)
+    length[length == 0] = 1.0
+    return (acc / length[:, None]).astype(np.float32)
+
+
+def prepare_cell(vertices: np.ndarray, faces: np.ndarray) -> PreparedCell:
+    """The cell's arrays in the dtypes the renderer takes, with point normals."""
+    v = np.ascontiguousarray(vertices, dtype=np.float32)
+    f = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
+    return PreparedCell(v, f, point_normals(v, f))
+
+
+def cell_for_tiling(cell: PreparedCell, copies: int, budget: int = TILED_TRIANGLE_BUDGET) -> PreparedCell:
+    """`cell` itself if `copies` of it fit the triangle `budget`, else a decimated copy
+    (quadric decimation, boundary edges constrained so the tiles still meet) that does."""
+    m = len(cell.faces)
+    if copies <= 1 or copies * m <= budget or m < 64:
+        return cell
+    reduction = 1.0 - budget / float(copies * m)
+    mesh = pv.PolyData.from_regular_faces(cell.vertices, cell.faces)
+    coarse = mesh.decimate(reduction, boundary_constraints=True)
+    faces = np.asarray(coarse.regular_faces, dtype=np.int64)
+    return prepare_cell(np.asarray(coarse.points), faces) if len(faces) else cell
+
+
+def tiled_polydata(cell: PreparedCell, offsets: np.ndarray, check=None) -> pv.PolyData:
+    """One merged mesh of the cell translated by each row of `offsets` (k, 3) mm,
+    with the cell's point normals as the active "Normals".
+
+    check : optional callable() run between chunks (raises to stop, e.g.
+        `Task.check`)."""
+    offsets = np.asarray(offsets, dtype=np.float32).reshape(-1, 3)
+    n, m, k = len(cell.vertices), len(cell.faces), len(offsets)
+    points = np.empty((k * n, 3), np.float32)
+    faces = np.empty((k * m, 3), np.int64)
+    for start in range(0, k, TILE_CHUNK):
+        if check is not None:
+            check()
+        for i in range(start, min(k, start + TILE_CHUNK)):
+            np.add(cell.vertices, offsets[i], out=points[i * n:(i + 1) * n])
+            np.add(cell.faces, i * n, out=faces[i * m:(i + 1) * m])
+    mesh = pv.PolyData.from_regular_faces(points, faces)
+    mesh.point_data["Normals"] = np.tile(cell.normals, (k, 1)) if k > 1 else cell.normals
+    mesh.point_data.active_normals_name = "Normals"
+    return mesh
+
+
+def skeleton_polydata(polylines: list[np.ndarray]) -> pv.PolyData | None:
+    """All polylines (each (p, 3) mm, p >= 2) as one line mesh; None if there is none."""
+    polylines = [np.asarray(p, dtype=float).reshape(-1, 3) for p in polylines]
+    polylines = [p for p in polylines if len(p) >= 2]
+    if not polylines:
+        return None
+    points = np.concatenate(polylines)
+    cells, start = [], 0
+    for p in polylines:
+        cells.append(np.concatenate([[len(p)], np.arange(start, start + len(p))]))
+        start += len(p)
+    return pv.PolyData(points, lines=np.concatenate(cells).astype(np.int64))
+
+
+def surfaces_polydata(surfaces: list[tuple[np.ndarray, np.ndarray]]) -> pv.PolyData | None:
+    """Triangle meshes ((v, 3) mm, (f, 3)) merged into one; None if none has a face."""
+    parts = [(np.asarray(v, float), np.asarray(f, np.int64).reshape(-1, 3)) for v, f in surfaces]
+    parts = [(v, f) for v, f in parts if len(f)]
+    if not parts:
+        return None
+    offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+    v = np.concatenate([v for v, _ in parts])
+    f = np.concatenate([f + o for (_, f), o in zip(parts, offsets)])
+    return pv.PolyData.from_regular_faces(v, f)
