@@ -11,7 +11,7 @@ FAMILY_COLOURS = {
     "skeleton": (70, 150, 220),
     "transform": (150, 110, 200),
     "solid": (90, 180, 110),
-    "property": (210, 90, 90),
+    "property": (60, 165, 175),     # teal: apart from the red of a failed node's outline
 }
 
 # Port dot colours by value type, so compatible ends are recognisable at a glance.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6 import QtGui
+from PySide6 import QtGui, QtWidgets
 
 from .undo_keys import REDO_KEYS, UNDO_KEYS, UndoKeys
 
@@ -100,8 +100,9 @@ class WindowMenus:
         view_menu.addAction(self.act_arrange)
         view_menu.addAction(self.act_reset_camera)
         view_menu.addSeparator()
-        for dock in (self.editor_dock, self.inspector_dock, self.growth_dock, self.log_dock):
-            view_menu.addAction(dock.toggleViewAction())
+        docks = view_menu.addMenu("Docks")           # every dock, by title
+        for dock in sorted(self.findChildren(QtWidgets.QDockWidget), key=lambda d: d.windowTitle()):
+            docks.addAction(dock.toggleViewAction())
 
         eval_menu = bar.addMenu("E&valuate")
         eval_menu.addAction(self.act_evaluate)

@@ -255,3 +255,21 @@ def test_closing_a_clean_window_does_not_ask(make_window, prompter):
     window = make_window()
     assert window.close()
     assert prompter.unsaved_asked == 0
+
+
+def test_the_view_menu_lists_every_dock(window):
+    from PySide6 import QtWidgets
+
+    view = next(a.menu() for a in window.menuBar().actions() if a.text() == "&View")
+    docks_menu = next(a.menu() for a in view.actions() if a.menu() is not None and a.text() == "Docks")
+    listed = {a.text() for a in docks_menu.actions()}
+    every = {d.windowTitle() for d in window.findChildren(QtWidgets.QDockWidget)}
+    assert len(every) >= 9 and listed == every
+
+
+def test_property_nodes_are_not_drawn_in_the_failure_red():
+    from ui.colours import FAMILY_COLOURS, STATUS_COLOURS
+
+    failed = tuple(int(STATUS_COLOURS["failed"][i:i + 2], 16) for i in (1, 3, 5))
+    r, g, b = FAMILY_COLOURS["property"]
+    assert abs(r - failed[0]) + abs(g - failed[1]) + abs(b - failed[2]) > 200
