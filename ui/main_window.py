@@ -221,6 +221,7 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
         self._shutting_down = True
         self._debounce.stop()
         self._autosave_timer.stop()
+        self.undo_keys.stop()
         self.growth_panel.detach()
         self.phasor_panel.shutdown()
         self.rd_panel.shutdown()

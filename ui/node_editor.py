@@ -19,7 +19,7 @@ from typing import Any
 from NodeGraphQt import BaseNode
 from NodeGraphQt.base.commands import PortConnectedCmd, PortDisconnectedCmd
 from NodeGraphQt.constants import PortTypeEnum
-from PySide6 import QtCore, QtGui, QtWidgets
+from PySide6 import QtCore, QtWidgets
 
 from engine.graph import (AddNode, Connect, Disconnect, Edge, GraphDocument, GraphError, Macro, MoveNode,
                           RemoveNode, SetLabel, UndoStack, all_node_types)
@@ -68,9 +68,12 @@ class NodeEditor(QtWidgets.QWidget):
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.graph.widget)
 
-        tab = QtGui.QShortcut(QtGui.QKeySequence(QtCore.Qt.Key.Key_Tab), self.graph.widget)
-        tab.setContext(QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut)
-        tab.activated.connect(self.graph.toggle_node_search)
+        # Tab opens node search.  An event filter on the viewer rather than a QShortcut
+        # child of NodeGraphQt's widget: destroying that shortcut's wrapper with the
+        # window crashed PySide 6.11 now and then (Shiboken releaseWrapper, seen in the
+        # window tests); the filter is removed in detach(), before the window goes.
+        self._tab_target = self.graph.viewer()
+        self._tab_target.installEventFilter(self)
 
         doc.subscribe(self._on_doc_event)
         self.rebuild()
@@ -105,8 +108,20 @@ class NodeEditor(QtWidgets.QWidget):
         menu.add_command("Fit view", lambda _graph: self.fit_view())
 
     def detach(self) -> None:
-        """Stop listening to the document (window closing)."""
+        """Stop listening to the document and to Tab (window closing)."""
         self.doc.unsubscribe(self._on_doc_event)
+        if self._tab_target is not None:
+            self._tab_target.removeEventFilter(self)
+            self._tab_target = None
+
+    def eventFilter(self, watched, event) -> bool:
+        """Tab in the graph view opens the node search (search-to-add)."""
+        if (watched is self._tab_target and event.type() == QtCore.QEvent.Type.KeyPress
+                and event.key() == QtCore.Qt.Key.Key_Tab
+                and event.modifiers() == QtCore.Qt.KeyboardModifier.NoModifier):
+            self.graph.toggle_node_search()
+            return True
+        return super().eventFilter(watched, event)
 
     # -- queries (also used by tests) -----------------------------------------
     def scene_node(self, node_id: str) -> BaseNode | None:

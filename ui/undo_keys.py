@@ -36,6 +36,12 @@ class UndoKeys(QtCore.QObject):
         self._undo, self._redo = undo, redo
         QtWidgets.QApplication.instance().installEventFilter(self)
 
+    def stop(self) -> None:
+        """Stop filtering (the window is closing: no event of its half-destroyed widgets comes here)."""
+        app = QtWidgets.QApplication.instance()
+        if app is not None:
+            app.removeEventFilter(self)
+
     def _owned(self, obj) -> bool:
         if not isinstance(obj, _TEXT_FIELDS):
             return False
