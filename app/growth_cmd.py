@@ -8,17 +8,15 @@ an interrupted study exits with 130 and keeps the rows it wrote (run it
 again to resume).
 
 The study's subprocess protocol (``study_argv``, ``study_process``,
-``parse_progress_line``) lives in ``engine.batch.study_process`` (the window
-imports it from there) and is re-exported here.
+``parse_progress_line``) lives in ``engine.batch.study_process``, shared by
+the command and the window.
 """
 
 from __future__ import annotations
 
 import sys
 
-from engine.batch.study_process import parse_progress_line, study_argv, study_process
-
-__all__ = ["COMMANDS", "add_parsers", "run", "parse_progress_line", "study_argv", "study_process"]
+__all__ = ["COMMANDS", "add_parsers", "run"]
 
 COMMANDS = ("grow", "study")
 

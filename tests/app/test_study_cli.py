@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from app import cli
-from app.growth_cmd import parse_progress_line, study_argv, study_process
+from engine.batch.study_process import parse_progress_line, study_argv, study_process
 import engine.batch.study as study_mod
 from engine.batch import read_study, run_study, sample_seed, sweep_hints
 
