@@ -29,15 +29,14 @@ import re
 import numpy as np
 from PySide6 import QtCore, QtWidgets
 
-from engine.graph import GraphError, all_node_types
+from engine.graph import all_node_types
 from engine.graph.errors import NodeInputError
 from engine.graph.query import nearest_upstream, of_types, type_of
 from engine.geometry.surfaces.values import SurfaceReport
 from engine.nodes.surfaces import boundary_schematic
 
 from .colours import STATUS_COLOURS
-from .inspector import EDITORS
-from .param_push import MergingParamPush
+from .param_form import ParamForm
 from .surface_plots import ConvergenceChart, LoopSchematic
 
 SURFACE_NODE_TYPES = ("Surface", "DualSurface", "AssociateFamily")
@@ -141,9 +140,7 @@ class SurfacePanel(QtWidgets.QWidget):
         self.node_id: str | None = None
         self.results: dict = {}
         self.outputs: dict = {}
-        self.editors: dict = {}
         self._stale: set[str] = set()      # nodes edited since the report shown
-        self._edits = MergingParamPush(undo)
         self._build()
         doc.subscribe(self._on_doc_event)
         self._refresh_list()
@@ -192,15 +189,12 @@ class SurfacePanel(QtWidgets.QWidget):
         self.solve_button.setToolTip("evaluate the graph now")
         self.solve_button.clicked.connect(self.evaluate_requested.emit)
         outer.addWidget(self.solve_button)
-        self.refused_label = QtWidgets.QLabel("")
-        self.refused_label.setWordWrap(True)
-        self.refused_label.setStyleSheet(ERROR_STYLE)
-        self.refused_label.hide()
-        outer.addWidget(self.refused_label)
 
         self.params_box = QtWidgets.QWidget()
         self.form = QtWidgets.QFormLayout(self.params_box)
         self.form.setFieldGrowthPolicy(QtWidgets.QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        self.param_form = ParamForm(self.doc, self.undo, self.form, self)
+        self.param_form.message.connect(self.message.emit)
         params = QtWidgets.QScrollArea()
         params.setWidgetResizable(True)
         params.setFrameShape(QtWidgets.QFrame.Shape.NoFrame)
@@ -356,60 +350,34 @@ class SurfacePanel(QtWidgets.QWidget):
         self.schematic.set_loop(points, sliding, labels, segment_chain, marked=marked)
 
     # -- parameter editors -------------------------------------------------------------------
+    @property
+    def editors(self) -> dict:
+        return self.param_form.editors
+
     def _build_editors(self) -> None:
-        while self.form.rowCount():
-            self.form.removeRow(0)
-        for editor in self.editors.values():
-            editor.deleteLater()
-        self.editors = {}
-        self._edits.reset()
-        self.refused_label.hide()
-        if self.node_id is None:
-            return
-        node = self.doc.nodes[self.node_id]
-        for param in all_node_types()[node.type_name].params:
-            editor = EDITORS[param.kind](param, self)
-            editor.set_value(node.params.get(param.name, param.default))
-            editor.edited.connect(lambda value, _name=param.name: self.commit(_name, value))
-            self.form.addRow(param.label or param.name.replace("_", " "), editor.widget)
-            self.editors[param.name] = editor
+        node_type = self.doc.nodes[self.node_id].type_name if self.node_id is not None else None
+        params = all_node_types()[node_type].params if node_type is not None else ()
+        self.param_form.show_node(self.node_id, params)
         self._update_visibility()
 
     def _update_visibility(self) -> None:
         params = self.doc.nodes[self.node_id].params if self.node_id else {}
-        for name, editor in self.editors.items():
+        for name in self.param_form.editors:
             other, values = SHOWN_WHEN.get(name, (None, None))
-            shown = other is None or params.get(other) in values
-            self.form.setRowVisible(editor.widget, shown)
+            self.param_form.set_row_visible(name, other is None or params.get(other) in values)
 
     def editor_widget(self, name: str) -> QtWidgets.QWidget:
         """The input widget of parameter ``name`` (tests drive it like a user would)."""
-        editor = self.editors[name]
-        return getattr(editor, "box", None) or getattr(editor, "table", None) or editor.widget
+        return self.param_form.editor_widget(name)
+
+    @property
+    def refused_label(self) -> QtWidgets.QLabel:
+        """The latest refusal's message, shown under its field."""
+        return self.param_form.error_label
 
     def commit(self, name: str, value) -> bool:
-        """Push one SetParam for the shown node; show a refusal inline."""
-        if self.node_id is None:
-            return False
-        try:
-            self._edits.push(self.node_id, name, value)
-        except GraphError as exc:
-            self.refused_label.setText(str(exc))
-            self.refused_label.show()
-            self.message.emit("error", f"refused: {exc}")
-            self._refresh_values()
-            return False
-        self.refused_label.hide()
-        return True
-
-    def _refresh_values(self) -> None:
-        if self.node_id is None:
-            return
-        params = self.doc.nodes[self.node_id].params
-        for name, editor in self.editors.items():
-            if name in params:
-                editor.set_value(params[name])
-        self._update_visibility()
+        """Push one SetParam for the shown node; a refusal is shown at its field."""
+        return self.param_form.commit(name, value)
 
     # -- document events ------------------------------------------------------------------------
     def _on_doc_event(self, event: str, payload) -> None:
@@ -424,9 +392,7 @@ class SurfacePanel(QtWidgets.QWidget):
             nid, name = payload
             self._stale.add(nid)
             if nid == self.node_id:
-                editor = self.editors.get(name)
-                if editor is not None:
-                    editor.set_value(self.doc.nodes[nid].params[name])
+                self.param_form.on_param_changed(nid, name)
                 self._update_visibility()
             sid = source_surface(self.doc, self.node_id) if self.node_id else None
             if self.node_id is not None and nid in (self.node_id, sid):

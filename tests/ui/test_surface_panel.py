@@ -138,3 +138,29 @@ def test_what_slides_follows_the_solver_and_the_report():
     assert sliding_segments("mixed_minimal", segment_chain, smooth, rep).tolist() == [0, 0, 0, 0, 1]
     assert error_vertex("node 's' (Surface): loop vertex 12 (chain 1, vertex 3), rule on-edge: …") == 12
     assert error_vertex("a surface needs edge chains") is None
+
+
+def test_a_typed_out_of_range_value_is_refused_at_its_field(window, qtbot, wait_eval):
+    from PySide6.QtCore import Qt
+
+    from engine.graph import document_to_dict
+
+    open_schwarz_p(window, wait_eval)
+    window.act_auto.setChecked(False)
+    panel = window.surface_panel
+    window.surface_dock.raise_()
+    before, depth = document_to_dict(window.doc), len(window.undo._done)
+    box = panel.editor_widget("edge_length")
+    box.lineEdit().selectAll()
+    qtbot.keyClicks(box.lineEdit(), "3")                     # allowed: [0.005, 1] cell
+    qtbot.keyClick(box, Qt.Key.Key_Return)
+    assert document_to_dict(window.doc) == before and len(window.undo._done) == depth
+    message = panel.param_form.messages["edge_length"]
+    assert panel.refused_label is message and message.refused
+    assert "edge_length = 3 refused" in message.text() and "[0.005, 1] cell" in message.text()
+    assert box.property("refused") is True and box.value() == pytest.approx(0.025)
+    box.setValue(0.03)                                        # a good value clears it
+    assert window.doc.nodes[SURFACE].params["edge_length"] == pytest.approx(0.03)
+    assert not message.refused and box.property("refused") is False
+    window.undo.undo()                                        # and undo shows the stored value
+    assert box.value() == pytest.approx(0.025)
