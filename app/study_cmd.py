@@ -9,7 +9,9 @@ Evaluator with the Grow node's ``seed`` parameter set to the sample's seed
 (``engine.batch``); ``--seed`` is the study seed (sample ``i`` grows with
 ``sample_seed(seed, i)``). The flags that set node parameters (``--size``,
 ``--hints``, ``--E``, ``--nu``, ``--resolution``, ``--void``) come from the
-nodes' schemas (`app.schema_flags`).
+nodes' schemas (`app.schema_flags`); the study's own (``--n``, ``--seed``,
+``--workers``, ``--sweep``, ``--min-distance``) from
+`engine.batch.study_params`, the schemas the Studies dock's fields use.
 
 A study grows ``--n`` samples from one set of ``--hints``; with ``--group``
 (repeated) it grows ``--n`` samples of each hint group into one file (set
@@ -27,7 +29,6 @@ prints ``progress DONE TOTAL`` lines on stderr as rows arrive, for the window
 from __future__ import annotations
 
 import json
-import math
 import signal
 import sys
 import time
@@ -41,7 +42,8 @@ _flags: dict = {}       # node type -> ParamFlags (set by add_parser)
 
 def add_parser(sub) -> None:
     """Register ``study`` on the subparsers ``sub``."""
-    from app.schema_flags import add_param_flags
+    from app.schema_flags import add_param_flags, help_text
+    from engine.batch.study_params import MIN_DISTANCE, SAMPLES, SEED, SWEEP, WORKERS
 
     s = sub.add_parser("study", help="property distribution of grown samples (Fig. 3)")
     s.add_argument("tileset", help="tile set name (resources/tilesets) or JSON file")
@@ -52,21 +54,23 @@ def add_parser(sub) -> None:
                    help="a hint group (repeat for several; '' = uniform): --n samples of each, "
                         "one set per group in --out")
     s.add_argument("--sweep", type=int, metavar="N",
-                   help="N hint vectors drawn uniformly on the simplex: --n samples of each")
-    s.add_argument("--min-distance", type=float, default=0.0,
-                   help="--sweep: least distance between hint vectors (default 0)")
-    s.add_argument("--n", type=int, default=100,
-                   help="number of samples (per group or hint vector; default 100)")
+                   help=f"N hint vectors drawn uniformly on the simplex: --n samples of each; "
+                        f"allowed: {SWEEP.allowed()}")
+    s.add_argument("--min-distance", type=float, default=MIN_DISTANCE.default, metavar="X",
+                   help=help_text(MIN_DISTANCE, "--sweep only"))
+    s.add_argument("--n", type=int, default=SAMPLES.default, metavar="N",
+                   help=help_text(SAMPLES))
     s.add_argument("--bounded", action="store_true",
                    help="grow bounded SVEs instead of periodic cells (the Grow node's periodic off)")
     s.add_argument("--out", help="rows file, .csv (or .parquet with pyarrow); resumed if present")
     s.add_argument("--no-resume", action="store_true", help="start --out afresh")
     s.add_argument("--scheduler", help="Dask scheduler address, or 'synchronous' for no Dask "
                                        "(default: a local cluster)")
-    s.add_argument("--workers", type=int, default=2, help="local cluster workers (default 2)")
-    s.add_argument("--seed", type=int, default=0, help="study seed (default 0)")
-    _flags["TilingProperties"] = add_param_flags(s, "TilingProperties", PROPERTY_FLAGS, help_extra={
-        "resolution": "0 = 20 in 2D, 10 in 3D"}, typed=("resolution",))    # the window's argv round-trips it as an int
+    s.add_argument("--workers", type=int, default=WORKERS.default, metavar="N",
+                   help=help_text(WORKERS))
+    s.add_argument("--seed", type=int, default=SEED.default, metavar="S", help=help_text(SEED))
+    # --resolution typed: the window's argv round-trips it as an int
+    _flags["TilingProperties"] = add_param_flags(s, "TilingProperties", PROPERTY_FLAGS, typed=("resolution",))
     s.add_argument("--progress-lines", action="store_true",
                    help="print 'progress DONE TOTAL' lines on stderr as rows arrive")
     s.add_argument("--json", action="store_true", help="print a JSON summary")
@@ -173,6 +177,36 @@ def _print_study(ts, size, summary) -> None:
         print(f"  rows in {summary['out_path']}")
 
 
+def study_flag(flag: str, param, value):
+    """``value`` of ``flag`` coerced by the study setting ``param`` (the Studies dock's rule,
+    `engine.batch.study_params`); FlagError naming the flag and the allowed range."""
+    from engine.graph import ParamError
+
+    try:
+        return param.coerce(value)
+    except ParamError as exc:
+        from engine.batch.study_params import expected
+        reason = f"expected {expected(param)}" if param.label else \
+            ("out of range" if exc.expected.startswith("a value in") else f"expected {exc.expected}")
+        raise FlagError(flag, value, reason, param.allowed()) from None
+
+
+def _check_study_values(args, mode: str, props: dict) -> None:
+    from engine.batch.study_params import (MIN_DISTANCE, SAMPLES, SEED, SWEEP, WORKERS,
+                                           check_resolution, resolution_param)
+
+    for flag, param, v in (("--n", SAMPLES, args.n), ("--seed", SEED, args.seed),
+                           ("--workers", WORKERS, args.workers),
+                           ("--min-distance", MIN_DISTANCE, args.min_distance)):
+        study_flag(flag, param, v)
+    if mode == "--sweep":
+        study_flag("--sweep", SWEEP, args.sweep)
+    try:
+        check_resolution(props["resolution"])
+    except ValueError as exc:
+        raise FlagError("--resolution", props["resolution"], str(exc), resolution_param().allowed()) from None
+
+
 def _check(args, ts) -> tuple:
     """Every refusal before any work: (size text, grid shape, node parameters)."""
     from app.flags import memory_value
@@ -188,15 +222,7 @@ def _check(args, ts) -> tuple:
     check_size("--size", size, grow["size"], ts)
     props = param_values(args, _flags["TilingProperties"], only_given=False)   # the node's defaults
     mode = _study_mode(args)
-    for flag, v, lo, allowed in (("--n", args.n, 1, "1, 2, ..."), ("--seed", args.seed, 0, "0, 1, 2, ..."),
-                                 ("--workers", args.workers, 1, "1, 2, ...")):
-        if v < lo:
-            raise FlagError(flag, v, f"expected {'a number of samples' if flag == '--n' else 'an integer'} "
-                                     f">= {lo}", allowed)
-    if mode == "--sweep" and args.sweep < 1:
-        raise FlagError("--sweep", args.sweep, "expected a number of hint vectors >= 1", "1, 2, ...")
-    if not math.isfinite(args.min_distance) or args.min_distance < 0:
-        raise FlagError("--min-distance", args.min_distance, "expected a number >= 0", "[0, inf)")
+    _check_study_values(args, mode, props)
     if args.hints:
         _parse("--hints", args.hints, ts)
     if args.group:

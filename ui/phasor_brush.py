@@ -2,9 +2,11 @@
 
 `BrushControls` binds the brush widgets (field, radius, strength, falloff,
 value, tilt, heading, depth) to one thing: the `engine.phasor.strokes.Stroke`
-a drag along some points makes (`make_stroke`).  Bad settings are not
-checked here: `error` reports the engine's own refusal, with the value as
-entered in degrees where the widget shows degrees.
+a drag along some points makes (`make_stroke`).  The number fields are
+`ToolNumber`s over the brush's schemas (`engine.nodes.phasor_brush`, made from
+the stroke's own limits): a typed value the stroke would refuse is refused at
+its field with the allowed range, never clamped or rounded; `error` reports
+the engine's refusal of the settings as a whole.
 """
 
 from __future__ import annotations
@@ -14,11 +16,13 @@ import math
 import numpy as np
 from PySide6 import QtCore, QtWidgets
 
-from engine.phasor.fields import MAX_SPREAD
+from engine.nodes.phasor_brush import brush_check, brush_param, brush_rule
 from engine.phasor.strokes import FALLOFFS, FIELDS, Stroke
 
+from .tool_number import ToolNumber
+
 FIELD_TEXT = {"D": "direction D", "F": "frequency F (cells/mm)", "Gamma": "spread Gamma (deg)"}
-VALUE_START = {"F": 1.0, "Gamma": 30.0}   # what the value box shows for a field not edited yet
+VALUE_START = {name: brush_param(name).default for name in ("F", "Gamma")}   # a field not edited yet
 
 
 class BrushControls(QtWidgets.QGroupBox):
@@ -42,43 +46,35 @@ class BrushControls(QtWidgets.QGroupBox):
         self.field_box.setCurrentIndex(1)
         self.field_box.currentIndexChanged.connect(self._on_field_changed)
         form.addRow("Paints", self.field_box)
-        self.radius_spin = self._spin(0.0, 1e4, 2.0, 0.25, suffix=" mm")
+        self.radius_spin = self._number("radius")
         form.addRow("Radius", self.radius_spin)
-        self.strength_spin = self._spin(0.0, 1.0, 1.0, 0.05, decimals=2)
+        self.strength_spin = self._number("strength")
         form.addRow("Strength", self.strength_spin)
         self.falloff_box = QtWidgets.QComboBox()
         for name in FALLOFFS:
             self.falloff_box.addItem(name, name)
         self.falloff_box.currentIndexChanged.connect(lambda _i: self._on_changed())
         form.addRow("Falloff", self.falloff_box)
-        # wide ranges on purpose: a bad value is refused with the engine's message
-        self.value_spin = self._spin(-1e4, 1e4, 1.0, 0.1, decimals=4)
+        self.value_spin = self._number("F")           # F or Gamma, as the field says
         self.value_label = QtWidgets.QLabel("Value")
         form.addRow(self.value_label, self.value_spin)
-        self.tilt_spin = self._spin(-360.0, 360.0, 0.0, 5.0, decimals=1, suffix="°")
-        self.tilt_spin.setToolTip("D: tilt out of the slice plane, towards +normal")
+        self.tilt_spin = self._number("tilt")
         form.addRow("Tilt", self.tilt_spin)
         heading = QtWidgets.QHBoxLayout()
         self.heading_check = QtWidgets.QCheckBox("fixed")
         self.heading_check.setToolTip("D: paint one in-plane heading instead of the drag direction")
         self.heading_check.toggled.connect(lambda _b: self._on_changed())
-        self.heading_spin = self._spin(-360.0, 360.0, 0.0, 15.0, decimals=1, suffix="°")
-        heading.addWidget(self.heading_check)
+        self.heading_spin = self._number("heading")
+        heading.addWidget(self.heading_check, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         heading.addWidget(self.heading_spin, 1)
         form.addRow("Heading", heading)
-        self.depth_spin = self._spin(0.0, 1e4, 0.0, 0.25, suffix=" mm")
-        self.depth_spin.setSpecialValueText("= radius")
-        self.depth_spin.setToolTip("how far the brush reaches out of the slice plane")
+        self.depth_spin = self._number("depth", special=(0.0, "= radius"))
         form.addRow("Depth", self.depth_spin)
+        self._remembered = dict(VALUE_START)       # the value box's value of each field
         self._show_field()
 
-    def _spin(self, lo, hi, value, step, decimals=3, suffix=""):
-        s = QtWidgets.QDoubleSpinBox()
-        s.setRange(lo, hi)
-        s.setDecimals(decimals)
-        s.setSingleStep(step)
-        s.setValue(value)
-        s.setSuffix(suffix)
+    def _number(self, name: str, special=None) -> ToolNumber:
+        s = ToolNumber(brush_param(name), check=brush_check(name), rule=brush_rule(name), special=special)
         s.valueChanged.connect(lambda _v: self._on_changed())
         return s
 
@@ -103,14 +99,12 @@ class BrushControls(QtWidgets.QGroupBox):
         return self.field == "D" and not self.heading_check.isChecked()
 
     def _show_field(self) -> None:
-        """Label, unit and remembered value of the value box for the current field."""
+        """Label, schema and remembered value of the value box for the current field."""
         name = self.field
-        self.value_spin.blockSignals(True)
         if name in VALUE_START:
             self.value_label.setText("F (cells/mm)" if name == "F" else "Gamma")
-            self.value_spin.setSuffix("" if name == "F" else "°")
-            self.value_spin.setValue(self.value_spin.property(name) or VALUE_START[name])
-        self.value_spin.blockSignals(False)
+            self.value_spin.set_param(brush_param(name), check=brush_check(name), rule=brush_rule(name),
+                                      value=self._remembered[name])
         is_d = name == "D"
         self.value_spin.setEnabled(not is_d)
         for w in (self.tilt_spin, self.heading_check, self.heading_spin):
@@ -123,7 +117,7 @@ class BrushControls(QtWidgets.QGroupBox):
 
     def _on_changed(self) -> None:
         if self.field in VALUE_START:
-            self.value_spin.setProperty(self.field, self.value_spin.value())
+            self._remembered[self.field] = self.value_spin.value()
         self.changed.emit()
 
     # -- the stroke ---------------------------------------------------------------------------
@@ -151,11 +145,6 @@ class BrushControls(QtWidgets.QGroupBox):
         """The engine's refusal of the current settings, or None."""
         try:
             self.make_stroke([[0.0, 0.0], [1.0, 0.0]], axis, position)
-        except ValueError as exc:
-            text = str(exc)
-            if self.field == "Gamma":
-                text += f" (entered {self.value_spin.value():g}°, allowed 0..{math.degrees(MAX_SPREAD):g}°)"
-            elif self.field == "D" and "tilt" in text:
-                text += f" (entered {self.tilt_spin.value():g}°, allowed -90..90°)"
-            return text
+        except ValueError as exc:       # the fields hold only values their schema allows
+            return str(exc)
         return None

@@ -24,10 +24,12 @@ from __future__ import annotations
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from engine.nodes.rd_brush import BRUSH_RADIUS, SOLID_VALUE, brush_check
 from engine.rd.preview import PLANE_AXES
 
 from .canvas_paint import begin_paint
 from .phasor_canvas import PhasorCanvas, _qimage
+from .tool_number import ToolNumber
 
 COMPARE_MODES = ("now", "before", "split")
 BRUSH_MODES = (("erase", "Erase structure"), ("draw", "Draw structure"), ("solid", "Mark solid (Gamma_c)"))
@@ -257,8 +259,9 @@ class GrowthPlot(QtWidgets.QWidget):
 class BrushBox(QtWidgets.QGroupBox):
     """Brush settings: mode (erase / draw / mark solid), radius, Gamma_c value.
 
-    The ranges are wide on purpose: a bad value is shown and refused by the
-    panel with the node's own message. ``changed`` fires on any edit.
+    The radius and value are `ToolNumber`s over `engine.nodes.rd_brush`'s schemas,
+    checked by the node's own stroke check: a value a stroke could not hold is
+    refused at its field, never clamped. ``changed`` fires on any edit.
     """
 
     changed = QtCore.Signal()
@@ -271,22 +274,14 @@ class BrushBox(QtWidgets.QGroupBox):
             self.mode_box.addItem(text, key)
         self.mode_box.currentIndexChanged.connect(self._on_changed)
         form.addRow("Mode", self.mode_box)
-        self.radius_spin = self._spin(-1e4, 1e4, 3.0, 0.5)
+        self.radius_spin = ToolNumber(BRUSH_RADIUS, check=brush_check("radius"), rule="> 0")
+        self.radius_spin.valueChanged.connect(self._on_changed)
         self.radius_label = QtWidgets.QLabel("Radius")
         form.addRow(self.radius_label, self.radius_spin)
-        self.value_spin = self._spin(-100.0, 100.0, 1.0, 0.1)
-        self.value_spin.setToolTip("Gamma_c of the marked cells: 1 = solid")
+        self.value_spin = ToolNumber(SOLID_VALUE, check=brush_check("value", solid=True))
+        self.value_spin.valueChanged.connect(self._on_changed)
         form.addRow("Solid value", self.value_spin)
         self._on_changed()
-
-    def _spin(self, lo, hi, value, step):
-        s = QtWidgets.QDoubleSpinBox()
-        s.setRange(lo, hi)
-        s.setDecimals(2)
-        s.setSingleStep(step)
-        s.setValue(value)
-        s.valueChanged.connect(self._on_changed)
-        return s
 
     @property
     def mode(self) -> str:

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
+from engine.nodes.rd_brush import LIVE_EVERY
+
 from .rd_canvas import GrowthPlot
+from .tool_number import ToolNumber
 from .rd_worker import LiveFrame, LiveGrowthWorker
 
 
@@ -53,11 +56,8 @@ class LiveGrowthBox(QtWidgets.QGroupBox):
         for b in (self.grow_button, self.pause_button, self.cancel_button, self.apply_button):
             row.addWidget(b)
         row.addWidget(QtWidgets.QLabel("every"))
-        self.every_spin = QtWidgets.QSpinBox()
-        self.every_spin.setRange(1, 100000)
-        self.every_spin.setValue(100)
-        self.every_spin.setSuffix(" steps")
-        row.addWidget(self.every_spin)
+        self.every_spin = ToolNumber(LIVE_EVERY)
+        row.addWidget(self.every_spin, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         v.addLayout(row)
         self.bar = QtWidgets.QProgressBar()
         self.bar.setRange(0, 1)

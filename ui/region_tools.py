@@ -15,8 +15,10 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from engine.batch.hints_text import parse_hints
 from engine.growth.regions import N_LABELS, format_region_hints, label_name, parse_region_hints
+from engine.nodes.growth_tools import REGION_BRUSH_RADIUS, region_brush_check
 
 from .region_canvas import label_rgb
+from .tool_number import ToolNumber
 
 N_BRUSH_LABELS = 10   # labels offered by the picker (0 erases); maps may hold up to N_LABELS
 ERROR_STYLE = "color: #c02020;"
@@ -85,16 +87,10 @@ class RegionTools(QtWidgets.QGroupBox):
 
         row = QtWidgets.QHBoxLayout()
         row.addWidget(QtWidgets.QLabel("Brush radius"))
-        self.radius = QtWidgets.QDoubleSpinBox()
-        self.radius.setRange(0.0, 100.0)
-        self.radius.setSingleStep(0.5)
-        self.radius.setDecimals(1)
-        self.radius.setValue(1.0)
-        self.radius.setSuffix(" cells")
-        self.radius.setToolTip("cells whose centres lie within this distance of the pointer are "
-                               "painted (0: the cell under the pointer)")
-        self.radius.valueChanged.connect(self.radiusChanged)
-        row.addWidget(self.radius)
+        # paint_disc's rule (engine.nodes.growth_tools): a typed radius is never clamped
+        self.radius = ToolNumber(REGION_BRUSH_RADIUS, check=region_brush_check)
+        self.radius.valueChanged.connect(lambda r: self.radiusChanged.emit(float(r)))
+        row.addWidget(self.radius, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         self.show_overlay = QtWidgets.QCheckBox("Show")
         self.show_overlay.setChecked(True)
         self.show_overlay.toggled.connect(self.overlayToggled)

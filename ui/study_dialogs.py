@@ -8,6 +8,8 @@ from PySide6 import QtWidgets
 
 from engine.growth import list_tilesets
 
+from .tool_number import ToolNumber
+
 DATABASE_FILTER = "Study database (*.csv *.parquet);;All files (*)"
 
 
@@ -58,12 +60,10 @@ def confirm_replace(parent, path: Path) -> bool:
     return answer == buttons.Yes
 
 
-def _spin(lo: int, hi: int, value: int, tip: str) -> QtWidgets.QSpinBox:
-    s = QtWidgets.QSpinBox()
-    s.setRange(lo, hi)
-    s.setValue(value)
-    s.setToolTip(tip)
-    return s
+def _number(param, **options) -> ToolNumber:
+    """A study setting's field over its schema (`engine.batch.study_params`): the rule
+    ``mesoforge study`` applies to the same flag, a refusal shown under the field."""
+    return ToolNumber(param, **options)
 
 
 def _row(*widgets) -> QtWidgets.QWidget:

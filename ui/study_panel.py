@@ -24,12 +24,14 @@ from pathlib import Path
 
 from PySide6 import QtCore, QtWidgets
 
+from engine.batch.study_params import (MIN_DISTANCE, SAMPLES, SEED, SWEEP, WORKERS, check_resolution,
+                                       resolution_param)
 from engine.batch.study_process import parse_progress_line, study_argv, study_process
 from engine.batch.study_summary import load_study
 from engine.growth import load_tileset
 
 from . import study_dialogs
-from .study_dialogs import _row, _spin, hint_groups_from_text, shipped_tilesets
+from .study_dialogs import _number, _row, hint_groups_from_text, shipped_tilesets
 from .study_plots import StudyPlots
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -89,11 +91,12 @@ class StudyPanel(QtWidgets.QWidget):
         self.size_edit.setToolTip("grid size in blocks: NXxNY (2D) or NXxNYxNZ (3D)")
         self.periodic_check = QtWidgets.QCheckBox("periodic cell")
         self.periodic_check.setChecked(True)
-        self.samples_spin = _spin(1, 1_000_000, 100, "samples grown for each hint group")
-        self.seed_spin = _spin(0, 2**31 - 1, 0, "study seed")
-        self.resolution_spin = _spin(0, 400, 0, "pixels (voxels) per block edge")
-        self.resolution_spin.setSpecialValueText("default")
-        self.workers_spin = _spin(1, 256, 2, "worker processes of the local Dask cluster")
+        # the fields refuse what `mesoforge study` refuses, with the same ranges (study_params)
+        self.samples_spin = _number(SAMPLES)
+        self.seed_spin = _number(SEED)
+        self.resolution_spin = _number(resolution_param(), check=check_resolution, rule="0 or >= 2",
+                                       special=(0, "default"))
+        self.workers_spin = _number(WORKERS)
         self.scheduler_edit = QtWidgets.QLineEdit()
         self.scheduler_edit.setPlaceholderText("local cluster (or tcp://host:8786)")
 
@@ -104,17 +107,14 @@ class StudyPanel(QtWidgets.QWidget):
         self.groups_edit.setToolTip("one group per line: block=weight,...; 'uniform' for equal "
                                     "weights")
         self.groups_edit.setFixedHeight(72)
-        self.sweep_spin = _spin(1, 100_000, 20, "hint vectors drawn uniformly on the simplex")
-        self.distance_spin = QtWidgets.QDoubleSpinBox()
-        self.distance_spin.setRange(0.0, 2.0)
-        self.distance_spin.setDecimals(3)
-        self.distance_spin.setSingleStep(0.01)
-        self.distance_spin.setToolTip("least distance between two hint vectors")
+        self.sweep_spin = _number(SWEEP)
+        self.distance_spin = _number(MIN_DISTANCE)
         sweep = QtWidgets.QHBoxLayout()
-        sweep.addWidget(QtWidgets.QLabel("sets"))
-        sweep.addWidget(self.sweep_spin)
-        sweep.addWidget(QtWidgets.QLabel("min distance"))
-        sweep.addWidget(self.distance_spin)
+        top = QtCore.Qt.AlignmentFlag.AlignTop
+        sweep.addWidget(QtWidgets.QLabel("sets"), 0, top)
+        sweep.addWidget(self.sweep_spin, 0, top)
+        sweep.addWidget(QtWidgets.QLabel("min distance"), 0, top)
+        sweep.addWidget(self.distance_spin, 0, top)
 
         self.out_edit = QtWidgets.QLineEdit()
         self.out_edit.setPlaceholderText("study.csv (or .parquet)")
@@ -212,13 +212,18 @@ class StudyPanel(QtWidgets.QWidget):
         out = self.database_path()
         if out is None:
             raise ValueError("Database: choose the .csv or .parquet file the rows go to")
+        sweep = self.sweep_radio.isChecked()
+        numbers = [self.samples_spin, self.seed_spin, self.resolution_spin, self.workers_spin]
+        for box in numbers + ([self.sweep_spin, self.distance_spin] if sweep else []):
+            if box.refused:           # the user typed a value the field refused: never run the kept one
+                raise ValueError(box.message.text())
         common = dict(n=self.samples_spin.value(), size=self.size_edit.text().strip(),
                       periodic=self.periodic_check.isChecked(), out=str(out),
                       seed=self.seed_spin.value(), workers=self.workers_spin.value(),
                       scheduler=self.scheduler_edit.text().strip() or None,
                       resolution=self.resolution_spin.value() or None, resume=resume)
         name = self.tileset_box.currentText()
-        if self.sweep_radio.isChecked():
+        if sweep:
             return study_argv(name, sweep=self.sweep_spin.value(),
                               min_distance=self.distance_spin.value(), **common)
         return study_argv(name, groups=hint_groups_from_text(self.groups_edit.toPlainText()),

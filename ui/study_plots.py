@@ -20,9 +20,12 @@ import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
-from PySide6 import QtWidgets
+from PySide6 import QtCore, QtWidgets
 
+from engine.batch.study_params import SAMPLE
 from engine.batch.study_summary import directional_modulus, group_directional_modulus, group_study
+
+from .tool_number import ToolNumber
 
 GROUP_COLOURS = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#b07aa1", "#76b7b2", "#edc948",
                  "#ff9da7", "#9c755f", "#bab0ac")
@@ -61,17 +64,13 @@ class StudyPlots(QtWidgets.QWidget):
         self.tabs.addTab(self.pies_canvas, "Probabilities")
 
         self.group_box = QtWidgets.QComboBox()
-        self.sample_spin = QtWidgets.QSpinBox()
-        self.sample_spin.setRange(-1, 0)
-        self.sample_spin.setValue(-1)
-        self.sample_spin.setSpecialValueText("group mean")
-        self.sample_spin.setToolTip("sample of the group (its index in the study), or the group's "
-                                    "mean curve")
+        # the range follows the group's samples; a typed index outside it is refused, not clamped
+        self.sample_spin = ToolNumber(SAMPLE, special=(-1, "group mean"))
         bar = QtWidgets.QHBoxLayout()
         bar.addWidget(QtWidgets.QLabel("Group"))
         bar.addWidget(self.group_box, 1)
         bar.addWidget(QtWidgets.QLabel("Sample"))
-        bar.addWidget(self.sample_spin)
+        bar.addWidget(self.sample_spin, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         polar = QtWidgets.QWidget()
         lay = QtWidgets.QVBoxLayout(polar)
         lay.setContentsMargins(0, 0, 0, 0)

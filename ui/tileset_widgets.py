@@ -11,6 +11,9 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from engine.growth.tileset_edit import (TileSetEditError, connectors_from_geometry, parse_point,
                                         parse_polylines)
+from engine.nodes.growth_tools import BLOCK_WEIGHT, block_weight_check
+
+from .tool_number import ToolNumber
 
 ICON_PX = 84
 GRID_DIVISIONS = 8          # the add-block canvas snaps clicks to 1/8 of the cell
@@ -32,12 +35,10 @@ def _error_label() -> QtWidgets.QLabel:
     return label
 
 
-def _weight_box() -> QtWidgets.QDoubleSpinBox:
-    box = QtWidgets.QDoubleSpinBox()
-    box.setRange(0.0, 1e6)
-    box.setDecimals(3)
-    box.setToolTip("the block's default frequency hint, shared by its orientations")
-    return box
+def _weight_box() -> ToolNumber:
+    """A block's weight: the tile-set loader's rule (engine.nodes.growth_tools), never clamped
+    or rounded (a QDoubleSpinBox kept 3 decimals and a maximum)."""
+    return ToolNumber(BLOCK_WEIGHT, check=block_weight_check)
 
 
 def _set_items(box: QtWidgets.QComboBox, items: list) -> None:

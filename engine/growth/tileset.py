@@ -29,12 +29,13 @@ from ._symmetry import (SYMMETRY_MODES, face_centres, face_names, geometry_key,
                         group_elements, opposite, transform_connectors,
                         transform_points)
 
-__all__ = ["Tile", "TileSet", "load_tileset", "parse_tileset", "list_tilesets",
-           "TILESET_DIR"]
+__all__ = ["Tile", "TileSet", "load_tileset", "parse_tileset", "list_tilesets", "check_block_weight",
+           "BLOCK_WEIGHT_MIN", "TILESET_DIR"]
 
 TILESET_DIR = Path(__file__).resolve().parents[2] / "resources" / "tilesets"
 FORMAT = "mesoforge-tileset"
 VERSION = 1
+BLOCK_WEIGHT_MIN = 0.0        # a block's weight: finite, >= this (the Tile Set dock shows it)
 _BLOCK_KEYS = {"name", "weight", "symmetry", "arms", "junction", "polylines",
                "connectors", "description"}
 _TOP_KEYS = {"format", "version", "name", "dim", "description", "blocks", "rules"}
@@ -180,6 +181,12 @@ def _check_number(value, what: str, lo=-math.inf, hi=math.inf) -> float:
             or not math.isfinite(value) or not lo <= value <= hi:
         raise ValueError(f"{what} must be a finite number in [{lo}, {hi}]; got {value!r}")
     return float(value)
+
+
+def check_block_weight(value, what: str = "weight") -> float:
+    """A block's weight (its default hint, shared by its orientations): a finite
+    number >= 0 (`BLOCK_WEIGHT_MIN`); ValueError naming ``what`` otherwise."""
+    return _check_number(value, what, BLOCK_WEIGHT_MIN)
 
 
 def _check_point(p, ndim: int, what: str) -> list:
@@ -335,7 +342,7 @@ def parse_tileset(data: Mapping, *, source: str | None = None) -> TileSet:
             raise ValueError(f"{where}: 'name' must be a unique non-empty string without '@'; "
                              f"got {bname!r}")
         where = f"tile set {name!r}{src}: block {bname!r}"
-        weight = _check_number(spec.get("weight", 1.0), f"{where}: 'weight'", 0.0)
+        weight = check_block_weight(spec.get("weight", 1.0), f"{where}: 'weight'")
         mode = spec.get("symmetry", "full")
         if mode not in SYMMETRY_MODES:
             raise ValueError(f"{where}: 'symmetry' must be one of {SYMMETRY_MODES}; got {mode!r}")

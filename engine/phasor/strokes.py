@@ -45,14 +45,26 @@ import numpy as np
 
 from engine.phasor.fields import MAX_SPREAD, PhasorFields
 
-__all__ = ["Stroke", "apply_stroke", "apply_strokes", "stroke_weights", "FALLOFFS", "FIELDS",
-           "PLANE_AXES"]
+__all__ = ["Stroke", "apply_stroke", "apply_strokes", "stroke_weights", "check_number", "FALLOFFS",
+           "FIELDS", "LIMITS", "PLANE_AXES"]
 
 FIELDS = ("D", "F", "Gamma")
 FALLOFFS = ("smooth", "linear", "constant")
 # plane axis -> (u, v, normal) as indices into (x, y, z)
 PLANE_AXES = {"x": (1, 2, 0), "y": (0, 2, 1), "z": (0, 1, 2)}
 _CANCELLED = 1e-9  # a blended direction shorter than this keeps the old one
+
+# What a stroke's numbers may be: name -> (low, high, low excluded, what is expected).
+# Checked here by `Stroke` and shown by the Phasor dock's brush (its `Param`s,
+# engine.nodes.phasor_brush, read these limits), so both say the same rule.
+LIMITS = {
+    "radius": (0.0, math.inf, True, "a finite number > 0 mm"),
+    "strength": (0.0, 1.0, False, "a number in [0, 1]"),
+    "depth": (0.0, math.inf, True, "a finite number > 0 mm"),
+    "F": (0.0, math.inf, True, "a frequency F > 0 cells/mm"),
+    "Gamma": (0.0, MAX_SPREAD, False, "an angular spread Gamma in [0, pi/2] radians"),
+    "tilt": (-math.pi / 2, math.pi / 2, False, "radians in [-pi/2, pi/2]"),
+}
 
 
 def _finite(v, name, *, positive=False, lo=None, hi=None, what="a finite number"):
@@ -63,6 +75,16 @@ def _finite(v, name, *, positive=False, lo=None, hi=None, what="a finite number"
     if (positive and not v > 0) or (lo is not None and v < lo) or (hi is not None and v > hi):
         raise ValueError(f"Stroke.{name}: expected {what}, got {v!r}")
     return v
+
+
+def check_number(name: str, v, *, field: str | None = None) -> float:
+    """``v`` as a float when `LIMITS` [name] allows it, else ValueError naming
+    ``Stroke.<field or name>``, the value and what is expected."""
+    lo, hi, open_lo, what = LIMITS[name]
+    x = _finite(v, field or name, what=what)
+    if (open_lo and not x > lo) or x < lo or x > hi:
+        raise ValueError(f"Stroke.{field or name}: expected {what}, got {x!r}")
+    return x
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,10 +125,10 @@ class Stroke:
             raise ValueError(f"Stroke.falloff: expected one of {', '.join(FALLOFFS)}, got {self.falloff!r}")
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731
         set_("position", _finite(self.position, "position"))
-        set_("radius", _finite(self.radius, "radius", positive=True, what="a finite number > 0 mm"))
-        set_("strength", _finite(self.strength, "strength", lo=0.0, hi=1.0, what="a number in [0, 1]"))
+        set_("radius", check_number("radius", self.radius))
+        set_("strength", check_number("strength", self.strength))
         if self.depth is not None:
-            set_("depth", _finite(self.depth, "depth", positive=True, what="a finite number > 0 mm"))
+            set_("depth", check_number("depth", self.depth))
         try:
             pts = np.array(self.points, dtype=np.float64)
         except (TypeError, ValueError):
@@ -124,8 +146,7 @@ class Stroke:
             if self.value is not None:
                 raise ValueError(f"Stroke.value: a D stroke paints a direction (heading, tilt), "
                                  f"not a value; got {self.value!r}")
-            set_("tilt", _finite(self.tilt, "tilt", lo=-math.pi / 2, hi=math.pi / 2,
-                                 what="radians in [-pi/2, pi/2]"))
+            set_("tilt", check_number("tilt", self.tilt))
             if self.heading is not None:
                 h = np.array(self.heading, dtype=np.float64)
                 if h.shape != (2,) or not np.all(np.isfinite(h)) or np.linalg.norm(h) < 1e-12:
@@ -140,12 +161,7 @@ class Stroke:
         if self.heading is not None or self.tilt != 0.0:
             raise ValueError(f"Stroke.heading: only D strokes have a heading or tilt "
                              f"(this one paints {self.field})")
-        if self.field == "F":
-            set_("value", _finite(self.value, "value", positive=True,
-                                  what="a frequency F > 0 cells/mm"))
-        else:
-            set_("value", _finite(self.value, "value", lo=0.0, hi=MAX_SPREAD,
-                                  what="an angular spread Gamma in [0, pi/2] radians"))
+        set_("value", check_number(self.field, self.value, field="value"))
 
     @property
     def reach(self) -> float:

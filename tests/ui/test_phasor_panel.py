@@ -20,6 +20,7 @@ from PySide6 import QtCore
 import engine.nodes  # noqa: F401  (registers the node types)
 from engine.graph import AddNode, Connect, Evaluator, GraphDocument, UndoStack
 from engine.gpu.slice_plane import SlicePlane
+from keyboard_entry import type_into
 
 LO, HI = [0.0, 0.0, 0.0], [20.0, 20.0, 20.0]
 # in-plane axes (u, v) per slice normal, as indices into (x, y, z)
@@ -166,25 +167,57 @@ def test_undo_then_new_outputs_refresh_the_view(qtbot, make_panel):
     assert np.array_equal(panel.shown_values, before)
 
 
-@pytest.mark.parametrize("field, value, words", [("F", -1.0, "frequency F > 0"),
-                                                 ("F", 0.0, "frequency F > 0"),
-                                                 ("Gamma", 100.0, "angular spread Gamma")])
-def test_a_bad_brush_value_is_refused_inline(qtbot, make_panel, field, value, words):
+@pytest.mark.parametrize("field, typed, words", [("F", "-1", "[0, inf] cells/mm"),
+                                                 ("F", "0", "frequency F > 0"),
+                                                 ("Gamma", "100", "[0, 90] °")])
+def test_a_bad_brush_value_is_refused_at_its_field(qtbot, make_panel, field, typed, words):
     g = Graph(CONSTANT)
     panel = make_panel(g, field=field)
-    image = panel.canvas.rgb.copy()
-    panel.value_spin.setValue(value)
-    assert words in panel.message.text()
+    kept = panel.value_spin.value()
+    type_into(qtbot, panel.value_spin, typed)
+    text = panel.value_spin.message.text()
+    assert panel.value_spin.refused and words in text and f"{field} = {typed} refused" in text
+    assert panel.value_spin.value() == kept                      # not clamped: the kept value
     drag(qtbot, panel.canvas, [widget_pos(panel.canvas, 0.3, 0.3), widget_pos(panel.canvas, 0.6, 0.6)])
-    assert g.strokes == [] and not g.undo.can_undo
-    assert "not painted" in panel.message.text() and words in panel.message.text()
-    assert np.array_equal(panel.canvas.rgb, image)
-    # a good value paints again; the settings were not lost
-    panel.value_spin.setValue(1.5 if field == "F" else 45.0)
-    assert panel.message.text() == ""
+    assert len(g.strokes) == 1                                    # painted with the kept value
+    assert g.strokes[0]["value"] == pytest.approx(kept if field == "F" else math.radians(kept))
+    # a good value clears the refusal and is painted
+    type_into(qtbot, panel.value_spin, "1.5" if field == "F" else "45")
+    assert not panel.value_spin.refused and panel.message.text() == ""
     drag(qtbot, panel.canvas, [widget_pos(panel.canvas, 0.3, 0.3), widget_pos(panel.canvas, 0.6, 0.6)])
-    assert len(g.strokes) == 1
-    assert g.strokes[0]["value"] == pytest.approx(1.5 if field == "F" else math.radians(45.0))
+    assert g.strokes[1]["value"] == pytest.approx(1.5 if field == "F" else math.radians(45.0))
+
+
+@pytest.mark.parametrize("name, typed, words", [("radius_spin", "-2", "[0, inf] mm"),
+                                                ("radius_spin", "0", "> 0 mm"),
+                                                ("strength_spin", "1.5", "[0, 1]"),
+                                                ("tilt_spin", "120", "[-90, 90] °"),
+                                                ("heading_spin", "600", "[-360, 360] °"),
+                                                ("depth_spin", "-1", "[0, inf] mm")])
+def test_brush_fields_refuse_out_of_range_values_and_keep_theirs(qtbot, make_panel, name, typed, words):
+    g = Graph(CONSTANT)
+    panel = make_panel(g, field="D" if name in ("tilt_spin", "heading_spin") else "F")
+    box = getattr(panel, name)
+    kept = box.value()
+    seen = []
+    box.valueChanged.connect(seen.append)
+    type_into(qtbot, box, typed)
+    assert box.refused and words in box.message.text() and "kept" in box.message.text()
+    assert box.value() == kept and seen == []
+    tip = box.toolTip()
+    assert "allowed:" in tip and "default:" in tip
+
+
+def test_depth_zero_shows_as_the_radius_and_a_precise_value_is_kept_exactly(qtbot, make_panel):
+    panel = make_panel(Graph(CONSTANT))
+    assert panel.depth_spin.value() == 0.0 and panel.depth_spin.lineEdit().text() == "= radius"
+    assert "= radius" in panel.depth_spin.toolTip()
+    type_into(qtbot, panel.depth_spin, "2.123456789")             # more digits than a QDoubleSpinBox keeps
+    assert panel.depth_spin.value() == 2.123456789
+    type_into(qtbot, panel.radius_spin, "600")                    # no silent cap at some maximum
+    assert panel.radius_spin.value() == 600.0 and not panel.radius_spin.refused
+    type_into(qtbot, panel.depth_spin, "= radius")
+    assert panel.depth_spin.value() == 0.0
 
 
 def test_the_field_view_changes_during_the_drag_only_inside_the_brush_box(qtbot, make_panel):

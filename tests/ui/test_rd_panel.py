@@ -21,6 +21,7 @@ import engine.nodes.rd  # noqa: F401  (the RD nodes, in case the package does no
 import engine.nodes.rd_topopt  # noqa: F401
 from engine.graph import AddNode, Connect, Evaluator, GraphDocument, UndoStack
 from engine.rd.field_io import RDFields, save_fields
+from keyboard_entry import type_into
 
 NX, NY = 32, 16          # fields grid (x, y)
 GX, GY = 96, 48          # growth grid
@@ -207,20 +208,29 @@ def test_mark_solid_appends_one_stroke_of_stamps_in_field_cells(qtbot, graph2d, 
     assert g.gamma_c == []
 
 
-def test_bad_brush_values_are_refused_inline_and_paint_nothing(qtbot, graph2d, make_panel):
+@pytest.mark.parametrize("name, typed, words", [("radius_spin", "-1", "[0, inf] cells"),
+                                                ("radius_spin", "0", "radius must be a number > 0"),
+                                                ("value_spin", "1.5", "[0, 1]"),
+                                                ("every_spin", "0", "[1, 10000000] steps"),
+                                                ("every_spin", "2.5", "an integer"),
+                                                ("every_spin", "20000000", "[1, 10000000] steps")])
+def test_bad_brush_and_live_values_are_refused_at_the_field(qtbot, graph2d, make_panel, name, typed, words):
     g = graph2d()
     panel = make_panel(g, view="s0")
-    panel.radius_spin.setValue(-1.0)
-    assert "radius" in panel.message.text()
-    drag(qtbot, panel.canvas, [widget_pos(panel.canvas, 0.4, 0.4), widget_pos(panel.canvas, 0.5, 0.5)])
-    assert g.edits == [] and not g.undo.can_undo
-    assert "not painted" in panel.message.text()
-    panel.radius_spin.setValue(2.0)
-    panel.mode_box.setCurrentIndex(2)
-    panel.value_spin.setValue(1.5)          # Gamma_c must lie in [0, 1]
-    assert "value" in panel.message.text()
-    drag(qtbot, panel.canvas, [widget_pos(panel.canvas, 0.4, 0.4), widget_pos(panel.canvas, 0.5, 0.5)])
-    assert g.gamma_c == [] and not g.undo.can_undo
+    if name == "value_spin":
+        panel.mode_box.setCurrentIndex(2)
+    box = getattr(panel, name)
+    kept = box.value()
+    type_into(qtbot, box, typed)
+    text = box.message.text()
+    assert box.refused and words in text and f"= {typed} refused" in text and "kept" in text
+    assert box.value() == kept                                   # never clamped
+    assert "allowed:" in box.toolTip() and "default:" in box.toolTip()
+    if name == "radius_spin":           # a drag paints with the kept radius
+        drag(qtbot, panel.canvas, [widget_pos(panel.canvas, 0.4, 0.4), widget_pos(panel.canvas, 0.5, 0.5)])
+        assert len(g.edits) == 1 and g.edits[0]["radius"] == kept
+    type_into(qtbot, box, "0.5" if name == "value_spin" else "20")
+    assert not box.refused and box.value() == (0.5 if name == "value_spin" else 20)
 
 
 def test_glyphs_follow_the_principal_directions_and_streamlines_draw(qtbot, graph2d, make_panel):

@@ -17,6 +17,7 @@ from engine.growth.values import TilingValue
 from engine.growth import UNASSIGNED, grow_tiling, load_tileset, regrow_region
 from engine.growth.regions import parse_region_map
 from engine.growth.regrow import dilate
+from keyboard_entry import type_into
 from ui.growth_panel import GrowthPanel
 
 LEFT = QtCore.Qt.MouseButton.LeftButton
@@ -333,3 +334,17 @@ def test_painting_waits_for_a_resized_grid(scene, qtbot):
     assert view.painting and view.grid_shape == (NY, NX + 2)
     drag(qtbot, view, [(0.5, 0.5), (2.5, 0.5)])
     assert parse_region_map(scene.regions, (NY, NX + 2)).sum() > 0
+
+
+@pytest.mark.parametrize("typed, words", [("-1", "[0, inf] cells"), ("inf", "a finite number"),
+                                          ("big", "a finite number")])
+def test_a_typed_bad_brush_radius_is_refused_at_the_field(scene, qtbot, typed, words):
+    tools, view = scene.panel.region_tools, scene.panel.view
+    kept = tools.radius.value()
+    type_into(qtbot, tools.radius, typed)
+    text = tools.radius.message.text()
+    assert tools.radius.refused and words in text and "radius" in text and "kept" in text
+    assert tools.radius.value() == kept and view.brush_radius == kept
+    assert "allowed:" in tools.radius.toolTip() and "cells" in tools.radius.toolTip()
+    type_into(qtbot, tools.radius, "250.25")                # beyond the old cap of 100, one more decimal
+    assert tools.radius.value() == 250.25 and view.brush_radius == 250.25 and not tools.radius.refused

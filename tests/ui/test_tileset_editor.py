@@ -7,6 +7,7 @@ from PySide6 import QtCore
 
 from engine.graph import AddNode, GraphDocument, UndoStack
 from engine.growth import TILESET_DIR, load_tileset
+from keyboard_entry import type_into
 from ui.tileset_editor import TileSetEditor
 
 LEFT = QtCore.Qt.MouseButton.LeftButton
@@ -218,3 +219,27 @@ def test_3d_set_shows_blocks_and_six_faces(qtbot, editor):
     ts = w.draft.tileset
     assert w.block_list.count() == 7 and ts.n_orientations[ts.block_index("I3")] == 3
     assert w.unsaved
+
+
+@pytest.mark.parametrize("typed, words", [("-1", "[0, inf]"), ("nan", "a finite number"),
+                                          ("heavy", "a finite number")])
+def test_a_typed_bad_weight_is_refused_at_the_field_and_nothing_changes(qtbot, editor, typed, words):
+    w = editor
+    _browse(w, "TL+-")
+    kept, undo = w.weight_box.value(), w.draft.undo_text()
+    type_into(qtbot, w.weight_box, typed)
+    text = w.weight_box.message.text()
+    assert w.weight_box.refused and words in text and "weight" in text and "kept" in text
+    assert w.weight_box.value() == kept and w.draft.undo_text() == undo and not w.draft.dirty
+    assert "allowed:" in w.weight_box.toolTip() and "default: 1" in w.weight_box.toolTip()
+
+
+def test_a_weight_is_kept_as_typed_not_rounded_or_capped(qtbot, editor):
+    w = editor
+    _browse(w, "TL+-")
+    type_into(qtbot, w.weight_box, "2.3456789")        # a QDoubleSpinBox kept 3 decimals
+    ts = w.draft.tileset
+    assert float(ts.weights[ts.tiles_of("T")].sum()) == pytest.approx(2.3456789, rel=1e-12)
+    type_into(qtbot, w.weight_box, "5000000")          # and capped at 1e6
+    ts = w.draft.tileset
+    assert float(ts.weights[ts.tiles_of("T")].sum()) == pytest.approx(5e6, rel=1e-12)
