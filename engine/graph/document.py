@@ -15,6 +15,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
+from .annotations import Annotations
 from .errors import GraphError
 from .node import node_type
 from .schema import ports_compatible
@@ -65,6 +66,7 @@ class GraphDocument:
         # whoever saves fills it from Evaluator.export_state, whoever opens imports it
         self.node_state: dict[str, dict] = {}
         self.load_warnings: list[str] = []  # what loading the project file dropped, and why
+        self.annotations = Annotations(self)  # frames and subgraphs (engine.graph.annotations)
         self._listeners: list[Callable[[str, Any], None]] = []
         self._counters: dict[str, int] = {}
 
@@ -145,6 +147,7 @@ class GraphDocument:
             items.insert(index, (node.id, node))
             self.nodes = dict(items)
         self.emit("node_added", node.id)
+        self.annotations._node_restored(node)  # undoing a removal puts it back in its subgraph
 
     def _raw_remove_node(self, node_id: str) -> tuple[NodeInstance, int]:
         node = self.node(node_id)
@@ -153,6 +156,7 @@ class GraphDocument:
         index = list(self.nodes).index(node_id)
         del self.nodes[node_id]
         self.node_state.pop(node_id, None)
+        self.annotations._node_removed(node)
         self.emit("node_removed", node_id)
         return node, index
 
@@ -284,6 +288,8 @@ class GraphDocument:
         self.meta = other.meta
         self.node_state = other.node_state
         self.load_warnings = other.load_warnings
+        self.annotations = other.annotations
+        self.annotations.doc = self
         self._counters = {}
         self.emit("reset", None)
 

@@ -28,6 +28,7 @@ from typing import Any, Callable
 
 from engine.fileio import write_atomic
 
+from .annotation_file import AnnotationsInvalid, annotations_to_dict, read_annotations
 from .document import Edge, GraphDocument, NodeInstance
 from .errors import GraphError, ParamError, ProjectFileError
 from .node import node_type
@@ -245,6 +246,8 @@ def document_to_dict(doc: GraphDocument) -> dict[str, Any]:
         ],
         "edges": [{"from": [e.src, e.src_port], "to": [e.dst, e.dst_port]} for e in doc.edges],
         "node_state": _kept_state(doc),
+        # frames and subgraphs (engine.graph.annotation_file); written only when there are any
+        **({"annotations": annotations_to_dict(doc.annotations)} if doc.annotations else {}),
     }
 
 
@@ -308,6 +311,11 @@ def document_from_dict(data: Any) -> GraphDocument:
     except GraphError as exc:
         raise InvalidProject(f"edges[{exc.index}]", str(exc)) from None
     doc.node_state, doc.load_warnings = _read_node_state(data.get("node_state", {}), doc)
+    if "annotations" in data:  # optional: older files have none
+        try:
+            read_annotations(data["annotations"], doc.annotations)
+        except AnnotationsInvalid as exc:
+            raise InvalidProject(exc.where, exc.reason) from None
     return doc
 
 
