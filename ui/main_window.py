@@ -9,7 +9,8 @@ question to the user goes through a `Prompter`, which tests replace.
 The window's parts live in small mixins: its widgets and docks
 (`ui.window_docks`), actions and menus (`ui.window_menus`), evaluation
 control (`ui.window_evaluation`) and files, export and autosave
-(`ui.window_files`); this module keeps the state, the log, the title and
+(`ui.window_files`), its dock layout kept between sessions
+(`ui.window_layout`); this module keeps the state, the log, the title and
 what the viewport shows.
 """
 
@@ -31,6 +32,7 @@ from .viewport import pick_display_nodes, pick_stiffness_node, skeleton_of, soli
 from .window_docks import WindowDocks
 from .window_evaluation import WindowEvaluation
 from .window_files import WindowFiles
+from .window_layout import WindowLayout, open_settings
 from .window_menus import EXAMPLES_DIR, WindowMenus
 
 __all__ = ["MainWindow", "EXAMPLES_DIR", "DEFAULT_EXAMPLE"]
@@ -40,13 +42,16 @@ EVAL_DEBOUNCE_MS = 150
 AUTOSAVE_INTERVAL_MS = 3 * 60 * 1000
 
 
-class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidgets.QMainWindow):
+class MainWindow(WindowDocks, WindowLayout, WindowMenus, WindowEvaluation, WindowFiles, QtWidgets.QMainWindow):
     """Node editor (left), 3D viewport (centre), inspector (right), log (bottom)."""
 
     evaluation_finished = QtCore.Signal(object)
 
     def __init__(self, *, autosave_dir: str | Path | None = None, prompter: Prompter | None = None,
-                 autosave_interval_ms: int = AUTOSAVE_INTERVAL_MS, parent=None):
+                 autosave_interval_ms: int = AUTOSAVE_INTERVAL_MS,
+                 settings: QtCore.QSettings | str | Path | None = None, parent=None):
+        """`settings`: where the window's layout is kept between sessions (a QSettings, or the
+        path of an ini file); None keeps nothing and starts with the default layout."""
         super().__init__(parent)
         self.setObjectName("MesoforgeMainWindow")
         self.prompter = prompter or Prompter(self)
@@ -68,6 +73,7 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
 
         self.worker = EvalWorker(parent=self)
         self.autosave = AutosaveManager(autosave_dir)
+        self.layout_settings = open_settings(settings)
 
         self._build_widgets()
         self._build_actions()
@@ -94,7 +100,8 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
         self.editor.message.connect(self.log)
         self.inspector.message.connect(self.log)
 
-        self.resize(1500, 900)
+        self.resize(self.default_window_size())
+        self.restore_layout()
         self._on_undo_changed()
 
     # -- log / status -----------------------------------------------------------------------
@@ -198,12 +205,11 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
     def showEvent(self, event: QtGui.QShowEvent) -> None:
         super().showEvent(event)
         if not getattr(self, "_docks_sized", False):
-            # Dock sizes only stick once the window has its real geometry.
+            # Dock sizes only stick once the window has its real geometry; a restored
+            # layout brings its own.
             self._docks_sized = True
-            w = self.width()
-            self.resizeDocks([self.editor_dock, self.inspector_dock], [int(w * 0.38), int(w * 0.2)],
-                             QtCore.Qt.Orientation.Horizontal)
-            self.resizeDocks([self.log_dock], [int(self.height() * 0.16)], QtCore.Qt.Orientation.Vertical)
+            if not self.layout_restored:
+                self.size_default_docks()
             QtCore.QTimer.singleShot(0, self.editor.fit_view)
 
     # -- closing ---------------------------------------------------------------------------
@@ -211,6 +217,8 @@ class MainWindow(WindowDocks, WindowMenus, WindowEvaluation, WindowFiles, QtWidg
         if not self._shutting_down and not (self.maybe_save() and self._tileset_edits_may_go()):
             event.ignore()
             return
+        if not self._shutting_down:
+            self.save_layout()
         self.shutdown()
         event.accept()
 
