@@ -5,15 +5,18 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from PySide6 import QtGui, QtWidgets
+from PySide6 import QtCore, QtGui, QtWidgets
 
+from app.thumbnails import render_in_child
 from ui.dialogs import Prompter
+from ui.example_gallery import show_at_startup, show_gallery
 from ui.main_window import DEFAULT_EXAMPLE, EXAMPLES_DIR, MainWindow
 
 
 def create_main_window(project_path: str | Path | None = None, autosave_dir: str | Path | None = None, *,
                        prompter: Prompter | None = None, open_example: bool = False,
-                       offer_recovery: bool = False, autosave_interval_ms: int | None = None) -> MainWindow:
+                       offer_recovery: bool = False, autosave_interval_ms: int | None = None,
+                       settings=None) -> MainWindow:
     """A MainWindow (a QApplication must exist) with `project_path` opened.
 
     Without a project, ``open_example=True`` loads the default example
@@ -21,10 +24,12 @@ def create_main_window(project_path: str | Path | None = None, autosave_dir: str
     (the default example ``mesoforge`` launches with, or any file under
     ``resources/``) opens as an untitled copy, so Save asks for a path and the
     shipped file is never overwritten.  With ``offer_recovery=True`` a crashed
-    session's autosave is offered first.
+    session's autosave is offered first.  `settings` (a QSettings or an ini file's
+    path) keeps the window's layout between sessions; None keeps nothing.
     """
     extra = {} if autosave_interval_ms is None else {"autosave_interval_ms": autosave_interval_ms}
-    window = MainWindow(autosave_dir=autosave_dir, prompter=prompter, **extra)
+    window = MainWindow(autosave_dir=autosave_dir, prompter=prompter, settings=settings, **extra)
+    window.thumbnail_renderer = render_in_child    # the gallery's missing thumbnails, off the GUI thread
     if offer_recovery and window.offer_recovery():
         return window
     if project_path is not None:
@@ -56,6 +61,13 @@ def apply_dark_theme(app: QtWidgets.QApplication) -> None:
     app.setPalette(pal)
 
 
+def wants_start_page(project_path, settings) -> bool:
+    """A plain ``mesoforge`` launch (no project, or the default example app.cli passes)
+    shows the example gallery, unless its "Show at startup" was turned off."""
+    plain = project_path is None or Path(project_path).resolve() == (EXAMPLES_DIR / DEFAULT_EXAMPLE).resolve()
+    return plain and show_at_startup(settings)
+
+
 def run_gui(project_path: str | None = None, argv=None) -> int:
     """Run the desktop application; returns the exit code."""
     argv = list(sys.argv if argv is None else argv)
@@ -63,8 +75,11 @@ def run_gui(project_path: str | None = None, argv=None) -> int:
     app.setApplicationName("Mesoforge")
     app.setOrganizationName("Mesoforge")
     apply_dark_theme(app)
-    window = create_main_window(project_path, open_example=project_path is None, offer_recovery=True)
+    window = create_main_window(project_path, open_example=project_path is None, offer_recovery=True,
+                                settings=QtCore.QSettings())    # the user's layout, per user
     window.show()
+    if wants_start_page(project_path, window.layout_settings):
+        show_gallery(window)            # the start page (non-modal)
     return int(app.exec())
 
 

@@ -3,7 +3,9 @@
 Shared by tools/make_examples.py (unit cells) and tools/surface_examples.py
 (shells and TPMS). Each method adds one node and returns its id, so an
 example reads like its construction; `document` replays the nodes through
-the undo stack as a user would, laying them out left to right by stage.
+the undo stack as a user would, laid out in readable columns
+(engine.graph.layout); `write_documents` adds each example's family and
+one-line summary from tools/example_catalogue.py to its meta.
 """
 
 from __future__ import annotations
@@ -11,6 +13,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project
+from engine.graph.layout import layered_positions
+
+from example_catalogue import catalogue_meta
 
 OBJECT_RESOLUTION = 96          # Object node grid, as in the paper's examples
 MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}   # paper section 8.2
@@ -21,11 +26,11 @@ ROW_HEIGHT = 110.0
 _OUT = {"Vertex": "point", "EdgeChain": "chain", "Line": "skeleton", "Surface": "skeleton",
         "DualSurface": "skeleton", "AssociateFamily": "skeleton", "Mirror": "skeleton",
         "Transform": "skeleton", "Group": "skeleton", "Object": "solid", "CSGBoolean": "solid",
-        "Voxel": "voxels"}
+        "Voxel": "voxels", "MaterialMatrix": "stiffness"}
 _IN = {"EdgeChain": "vertices", "Line": "chains", "Surface": "chains", "DualSurface": "skeleton",
        "AssociateFamily": "skeleton", "Mirror": "skeleton", "Transform": "skeleton",
-       "Group": "skeletons", "Object": "skeleton", "CSGBoolean": "solids", "Voxel": "solid"}
-_SOLID_STAGE = ("Object", "CSGBoolean", "Voxel")
+       "Group": "skeletons", "Object": "skeleton", "CSGBoolean": "solids", "Voxel": "solid",
+       "MaterialMatrix": "voxels"}
 
 
 def r6(x) -> float:
@@ -109,6 +114,10 @@ class GraphBuilder:
     def voxel(self, node_id: str, solid: str) -> str:
         return self._node(node_id, "Voxel", dict(MATERIAL), [solid])
 
+    def material_matrix(self, node_id: str, voxels: str, *, resolution: int) -> str:
+        """The stiffness tensor of the voxelized cell (paper 6.6)."""
+        return self._node(node_id, "MaterialMatrix", {"resolution": int(resolution)}, [voxels])
+
     # -- shared constructions ---------------------------------------------
     def threefold(self, prefix: str, source: str) -> str:
         """Copies at 0, 120 and 240 degrees about the body diagonal through
@@ -120,26 +129,12 @@ class GraphBuilder:
         return self.group(f"{prefix}{s}xyz", [a, b])
 
     # -- replay -----------------------------------------------------------
-    def _columns(self) -> dict[str, int]:
-        col: dict[str, int] = {}
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name not in _SOLID_STAGE:
-                col[node_id] = 1 + max((col[i] for i in inputs), default=-1)
-        object_column = 1 + max(col.values(), default=-1)
-        for node_id, type_name, _, inputs in self._nodes:
-            if type_name == "Object":
-                col[node_id] = object_column
-            elif type_name in _SOLID_STAGE:
-                col[node_id] = 1 + max(col[i] for i in inputs)
-        return col
-
     def positions(self) -> dict[str, tuple[float, float]]:
-        col = self._columns()
-        per_column: dict[int, list[str]] = {}
-        for node_id, *_ in self._nodes:
-            per_column.setdefault(col[node_id], []).append(node_id)
-        return {node_id: (c * COLUMN_WIDTH, ROW_HEIGHT * (row - (len(ids) - 1) / 2.0))
-                for c, ids in per_column.items() for row, node_id in enumerate(ids)}
+        """Readable columns (engine.graph.layout.layered_positions): a node's
+        column is its depth, rows ordered to reduce edge crossings."""
+        edges = [(src, node_id) for node_id, _, _, inputs in self._nodes for src in inputs]
+        return layered_positions([n[0] for n in self._nodes], edges,
+                                 column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
 
     def document(self) -> GraphDocument:
         doc = GraphDocument(seed=0)
@@ -161,6 +156,7 @@ def write_documents(builders: dict, out_dir, names=None, *, prefix: str = "") ->
     written = {}
     for name in names or builders:
         doc = builders[name]()
+        doc.meta.update(catalogue_meta(f"{prefix}{name}"))   # family and one-line summary
         path = out / f"{prefix}{name}.json"
         save_project(doc, path)
         written[path] = doc

@@ -15,8 +15,14 @@ al. 2023, section 3):
 All structures are periodic unit cells on [0, 1]^3: the Object node wraps
 geometry across the cell faces, so members that leave through one face
 re-enter through the opposite one.  Node ids are stable and readable, and
-node positions are laid out left to right by stage (vertices, edge chains,
-lines, transforms ..., objects, CSG, voxel) so the editor shows a tidy graph.
+node positions are laid out in readable columns (engine.graph.layout: a
+node's column is its depth, rows ordered to reduce crossings).
+
+Beside the unit cells: property examples (a cell followed by a Material
+Matrix node), virtual growth examples (Tile Set -> Grow -> Tiling Image /
+Beams + Tiling Properties), a phasor infill and a reaction-diffusion example.
+Each example's family and one-line summary (the gallery shows them) come
+from ``tools/example_catalogue.py``.
 
 Usage::
 
@@ -45,7 +51,10 @@ if str(ROOT) not in sys.path:
 from engine.graph import AddNode, Connect, GraphDocument, UndoStack  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from graph_builder import COLUMN_WIDTH, GraphBuilder as _Builder, r6, vec6, write_documents  # noqa: E402
+from graph_builder import (COLUMN_WIDTH, ROW_HEIGHT, GraphBuilder as _Builder, r6, vec6,  # noqa: E402
+                           write_documents)
+
+from engine.graph.layout import layered_positions  # noqa: E402
 
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 
@@ -448,6 +457,120 @@ EXAMPLES: dict[str, Callable[[], GraphBuilder]] = {
 }
 
 
+# =============================================================== property examples
+#
+# A unit cell followed by a Material Matrix node (paper section 6.6): the
+# window's material sphere and Material Matrix dock show its stiffness as soon
+# as the example is open.
+
+STIFFNESS_RESOLUTION = 48       # voxels per cell edge of the homogenization solve
+
+
+def octet_stiffness() -> GraphBuilder:
+    b = octet()
+    b.name = "octet_stiffness"
+    b.meta.update(example="octet_stiffness", title="Octet truss: stiffness", paper_node_count=None,
+                  description="The octet truss of the lattice examples followed by a Material Matrix "
+                              "node: periodic homogenization of the voxelized cell gives its "
+                              "effective stiffness tensor C (cubic symmetry), the engineering "
+                              "constants and the directional Young's modulus drawn as the material "
+                              "sphere.")
+    b.material_matrix("stiffness", "voxel", resolution=STIFFNESS_RESOLUTION)
+    return b
+
+
+def schwarz_p_stiffness():
+    from surface_examples import schwarz_p
+
+    b = schwarz_p()
+    b.name = "schwarz_p_stiffness"
+    b.meta.update(example="schwarz_p_stiffness", title="Schwarz P shell: stiffness", paper_node_count=None,
+                  description="The Schwarz P shell of the TPMS examples followed by a Material Matrix "
+                              "node: the stiffness tensor of a thin minimal-surface shell, cubic like "
+                              "the octet but far more isotropic (compare their material spheres).")
+    b.material_matrix("stiffness", "voxel", resolution=STIFFNESS_RESOLUTION)
+    return b
+
+
+PROPERTY_EXAMPLES: dict[str, Callable] = {
+    "octet_stiffness": octet_stiffness,
+    "schwarz_p_stiffness": schwarz_p_stiffness,
+}
+
+
+def write_property_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
+    """Build the property examples (all, or `names`) as ``<out_dir>/<name>.json``."""
+    return write_documents({n: (lambda n=n: PROPERTY_EXAMPLES[n]().document()) for n in PROPERTY_EXAMPLES},
+                           out_dir, names)
+
+
+# =============================================================== virtual growth examples
+#
+# Tile sets grown by wave-function collapse (Liu, Sun & Daraio 2022, virtual growth),
+# each Grow node followed by Tiling Properties, so the Virtual Growth dock
+# shows the tiling, its block mix and its stiffness when the example opens.
+
+def _growth_document(name: str, meta: dict, tileset: str, grow: dict, *, three_d: bool) -> GraphDocument:
+    doc = GraphDocument(seed=0)
+    doc.meta = {"example": name, "source": "Liu, Sun & Daraio 2022 (virtual growth)",
+                "paper_node_count": None, **meta}
+    show = ("beams", "TilingBeams", "skeleton") if three_d else ("image", "TilingImage", "image")
+    nodes = [("tileset", "TileSet", {"name": tileset}), ("grow", "Grow", grow),
+             (show[0], show[1], {}), ("properties", "TilingProperties", {})]
+    edges = [("tileset", "tileset", "grow", "tileset"), ("grow", "tiling", show[0], "tiling"),
+             ("grow", "tiling", "properties", "tiling")]
+    pos = layered_positions([n[0] for n in nodes], [(e[0], e[2]) for e in edges],
+                            column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
+    stack = UndoStack(doc)
+    for node_id, type_name, params in nodes:
+        stack.push(AddNode(type_name, params, pos[node_id], node_id=node_id))
+    for edge in edges:
+        stack.push(Connect(*edge))
+    return doc
+
+
+def growth_tl_2d() -> GraphDocument:
+    return _growth_document("growth_tl_2d", {
+        "title": "Virtual growth: TL+- tiling",
+        "description": "A periodic 16 x 16 tiling of the TL+- blocks (T, L, straight and cross "
+                       "beams) grown by minimal-entropy wave-function collapse under the set's "
+                       "adjacency rules and weights. Tiling Image draws it; Tiling Properties "
+                       "homogenizes the pixel image in plane stress. Change the seed or the hints "
+                       "in the Virtual Growth dock and watch the stiffness follow; the Study dock "
+                       "runs the same grid as a property study."},
+        "TL+-", {"size": [16, 16]}, three_d=False)
+
+
+def growth_tl_hints() -> GraphDocument:
+    return _growth_document("growth_tl_hints", {
+        "title": "Virtual growth: hinted towards + and -",
+        "description": "The TL+- set on the same 16 x 16 grid, with frequency hints "
+                       "T=1,L=1,+=3,-=2 that favour the cross and straight blocks. More "
+                       "continuous load paths: compare its stiffness with the unhinted example."},
+        "TL+-", {"size": [16, 16], "hints": "T=1,L=1,+=3,-=2"}, three_d=False)
+
+
+def growth_cubic_3d() -> GraphDocument:
+    return _growth_document("growth_cubic_3d", {
+        "title": "Virtual growth: 3D cubic beams",
+        "description": "A periodic 4 x 4 x 4 tiling of the cubic-beams set (3D cross, planar cross, "
+                       "T, Y, L and straight junctions). Tiling Beams turns it into a beam "
+                       "skeleton; Tiling Properties voxelizes the beams and homogenizes them in 3D."},
+        "cubic-beams", {"size": [4, 4, 4]}, three_d=True)
+
+
+GROWTH_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
+    "growth_tl_2d": growth_tl_2d,
+    "growth_tl_hints": growth_tl_hints,
+    "growth_cubic_3d": growth_cubic_3d,
+}
+
+
+def write_growth_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
+    """Build the virtual growth examples (all, or `names`) as ``<out_dir>/<name>.json``."""
+    return write_documents(GROWTH_EXAMPLES, out_dir, names)
+
+
 # =============================================================== phasor infill examples
 #
 # Not unit cells: a part's box filled with phasor-noise diamond cells (Tricard
@@ -573,23 +696,31 @@ def _surface_examples():
 SURFACE_EXAMPLES, write_surface_examples = _surface_examples()
 
 
+def all_writers() -> dict[str, tuple[dict, Callable]]:
+    """Every example generator: ``{kind: (its builders by name, its writer)}``."""
+    return {"cells": (EXAMPLES, write_examples), "properties": (PROPERTY_EXAMPLES, write_property_examples),
+            "growth": (GROWTH_EXAMPLES, write_growth_examples), "phasor": (PHASOR_EXAMPLES, write_phasor_examples),
+            "rd": (RD_EXAMPLES, write_rd_examples), "surfaces": (SURFACE_EXAMPLES, write_surface_examples)}
+
+
+def write_all(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:
+    """Build every example (or those in `names`) into `out_dir`."""
+    written: dict[Path, GraphDocument] = {}
+    for builders, writer in all_writers().values():
+        picked = [n for n in names or builders if n in builders]
+        if picked:
+            written.update(writer(out_dir, picked))
+    return written
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=str(EXAMPLES_DIR), help="output folder (default: resources/examples)")
     parser.add_argument("--only", nargs="+",
-                        choices=sorted(EXAMPLES) + sorted(PHASOR_EXAMPLES) + sorted(RD_EXAMPLES)
-                        + sorted(SURFACE_EXAMPLES),
+                        choices=sorted(n for builders, _ in all_writers().values() for n in builders),
                         help="build only these examples")
     args = parser.parse_args(argv)
-    cells = [n for n in args.only or EXAMPLES if n in EXAMPLES]
-    phasor = [n for n in args.only or PHASOR_EXAMPLES if n in PHASOR_EXAMPLES]
-    rd = [n for n in args.only or RD_EXAMPLES if n in RD_EXAMPLES]
-    surfaces = [n for n in args.only or SURFACE_EXAMPLES if n in SURFACE_EXAMPLES]
-    written = {**(write_examples(args.out, cells) if cells else {}),
-               **(write_phasor_examples(args.out, phasor) if phasor else {}),
-               **(write_rd_examples(args.out, rd) if rd else {}),
-               **(write_surface_examples(args.out, surfaces) if surfaces else {})}
-    for path, doc in written.items():
+    for path, doc in write_all(args.out, args.only).items():
         paper = doc.meta.get("paper_node_count")
         print(f"{path}  ({len(doc.nodes)} nodes; paper: {paper if paper is not None else '-'})")
     return 0

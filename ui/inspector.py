@@ -23,18 +23,12 @@ from engine.graph import GraphDocument, GraphError, SetLabel, UndoStack, all_nod
 from engine.physics.values import Stiffness
 
 from .colours import STATUS_COLOURS, family_colour
-from .field_message import FieldMessage, refusal_text
-from .param_editors import (BoolEditor, EnumEditor, FloatEditor, IntEditor, IntListEditor, ParamEditor, StrEditor,
-                            Vec3Editor)
-from .param_push import MergingParamPush
+from .field_message import FieldMessage
+from .param_form import EDITORS, ParamForm
+from .rich_text import doc_to_html
 from .stiffness_panel import StiffnessPanel
-from .structured_editors import JsonEditor, SamplesEditor
 
-EDITORS = {
-    "float": FloatEditor, "int": IntEditor, "bool": BoolEditor, "enum": EnumEditor, "str": StrEditor,
-    "vec3": Vec3Editor, "int_list": IntListEditor, "samples": SamplesEditor, "json": JsonEditor,
-}
-"""The editor class of each parameter kind (``Param.kind``)."""
+__all__ = ["Inspector", "EDITORS"]
 
 
 class Inspector(QtWidgets.QWidget):
@@ -47,13 +41,8 @@ class Inspector(QtWidgets.QWidget):
         self.doc = doc
         self.undo = undo
         self.node_id: str | None = None
-        self.editors: dict[str, ParamEditor] = {}
-        self.messages: dict[str, FieldMessage] = {}   # the refusal message under each field
-        self._refused: FieldMessage | None = None       # the latest refusal shown
-        self._no_refusal = FieldMessage([], self)
         self._results: dict = {}
         self._outputs: dict = {}
-        self._edits = MergingParamPush(undo)
 
         outer = QtWidgets.QVBoxLayout(self)
         outer.setContentsMargins(6, 6, 6, 6)
@@ -65,6 +54,7 @@ class Inspector(QtWidgets.QWidget):
         outer.addWidget(self.title)
         self.description = QtWidgets.QLabel("Select a node in the editor to edit its parameters.")
         self.description.setWordWrap(True)
+        self.description.setTextFormat(QtCore.Qt.TextFormat.RichText)
         self.description.setStyleSheet("color: #9aa0a6;")
         outer.addWidget(self.description)
 
@@ -84,6 +74,8 @@ class Inspector(QtWidgets.QWidget):
 
         self.params_box = QtWidgets.QGroupBox("Parameters")
         self.form = QtWidgets.QFormLayout(self.params_box)
+        self.param_form = ParamForm(doc, undo, self.form, self)
+        self.param_form.message.connect(self.message.emit)
         self.form.setFieldGrowthPolicy(QtWidgets.QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         outer.addWidget(self.params_box)
 
@@ -111,8 +103,7 @@ class Inspector(QtWidgets.QWidget):
         if node_id is not None and node_id not in self.doc.nodes:
             node_id = None
         self.node_id = node_id
-        self._edits.reset()
-        self._clear_form()
+        self.param_form.show_node(None)
         self.label_message.clear()
         has = node_id is not None
         for w in (self.ident_box, self.params_box, self.status_box):
@@ -127,75 +118,40 @@ class Inspector(QtWidgets.QWidget):
         r, g, b = family_colour(cls.family, (150, 150, 150))
         self.title.setText(f"<span style='color: rgb({r},{g},{b})'>■</span> {cls.title or inst.type_name}"
                            f" <span style='color:#9aa0a6; font-weight:normal'>({cls.family})</span>")
-        self.description.setText(" ".join((cls.__doc__ or "").split()))
+        self.description.setText(doc_to_html(cls.__doc__))      # ``code``, *emph*, lists as rich text
         self.id_label.setText(node_id)
         self.label_edit.setText(inst.label)
-        for param in cls.params:
-            editor = EDITORS[param.kind](param, self)
-            editor.set_value(inst.params.get(param.name, param.default))
-            editor.edited.connect(lambda value, _name=param.name: self.commit(_name, value))
-            label = QtWidgets.QLabel(param.label or param.name.replace("_", " "))
-            label.setToolTip(editor.tooltip)
-            self.form.addRow(label, editor.widget)
-            message = FieldMessage(editor.inputs())
-            self.form.addRow(message)
-            self.editors[param.name] = editor
-            self.messages[param.name] = message
+        self.param_form.show_node(node_id, cls.params)
         self.params_box.setVisible(bool(cls.params))
         self._show_status()
 
-    def _clear_form(self) -> None:
-        while self.form.rowCount():
-            self.form.removeRow(0)
-        for e in self.editors.values():
-            e.deleteLater()
-        self.editors = {}
-        self.messages = {}
-        self._refused = None
+    # -- the parameters' form (ui.param_form) ---------------------------------------
+    @property
+    def editors(self) -> dict:
+        return self.param_form.editors
+
+    @property
+    def messages(self) -> dict[str, FieldMessage]:
+        """The refusal message under each field."""
+        return self.param_form.messages
 
     def editor_widget(self, name: str) -> QtWidgets.QWidget:
         """The input widget of parameter `name` (tests drive it like a user would)."""
-        editor = self.editors[name]
-        return getattr(editor, "box", None) or getattr(editor, "table", None) or editor.widget
+        return self.param_form.editor_widget(name)
 
     @property
     def error_label(self) -> QtWidgets.QLabel:
         """The message of the latest refusal, under its field (a hidden label when none)."""
-        return self._refused if self._refused is not None else self._no_refusal
+        return self.param_form.error_label
 
-    # -- edits ------------------------------------------------------------------
     def commit(self, name: str, value: Any) -> bool:
         """Push SetParam for the shown node (nothing when `value` is the stored one);
         a refused value is shown at its field and changes nothing."""
-        if self.node_id is None:
-            return False
-        params = self.doc.nodes[self.node_id].params
-        message = self.messages.get(name)
-        if name in params and _same(value, params[name]):
-            self._refresh_values()                      # e.g. "32" retyped: no undo item
-            if message is not None:
-                message.clear()
-            return True
-        try:
-            self._edits.push(self.node_id, name, value)
-        except GraphError as exc:
-            self._refresh_values()
-            self.refuse(name, exc)
-            return False
-        if message is not None:
-            message.clear()
-        return True
+        return self.param_form.commit(name, value)
 
     def refuse(self, name: str, exc: GraphError) -> None:
         """Show why `name`'s new value was refused, at its field and in the log."""
-        param = self.editors[name].param if name in self.editors else None
-        params = self.doc.nodes[self.node_id].params if self.node_id in self.doc.nodes else {}
-        text = refusal_text(param, exc, params.get(name)) if param is not None else str(exc)
-        message = self.messages.get(name)
-        if message is not None:
-            message.refuse(text)
-            self._refused = message
-        self.message.emit("error", f"refused: {exc}")
+        self.param_form.refuse(name, exc)
 
     def _commit_label(self) -> None:
         if self.node_id is None:
@@ -211,22 +167,11 @@ class Inspector(QtWidgets.QWidget):
                 return
         self.label_message.clear()
 
-    def _refresh_values(self) -> None:
-        if self.node_id is None or self.node_id not in self.doc.nodes:
-            return
-        params = self.doc.nodes[self.node_id].params
-        for name, editor in self.editors.items():
-            if name in params:
-                editor.set_value(params[name])
-
     def _on_doc_event(self, event: str, payload) -> None:
         if self.node_id is None:
             return
-        if event == "param_changed" and payload[0] == self.node_id:
-            editor = self.editors.get(payload[1])
-            if editor is not None:
-                editor.set_value(self.doc.nodes[self.node_id].params[payload[1]])
-                self.messages[payload[1]].clear()       # an undo / redo made the refusal stale
+        if event == "param_changed":
+            self.param_form.on_param_changed(*payload)  # an undo / redo also makes a refusal stale
         elif event == "label_changed" and payload == self.node_id:
             self.label_edit.setText(self.doc.nodes[self.node_id].label)
         elif (event == "node_removed" and payload == self.node_id) or event == "reset":
@@ -273,13 +218,6 @@ class Inspector(QtWidgets.QWidget):
 
     def status_text(self) -> str:
         return self.status_label.text()
-
-
-def _same(value: Any, stored: Any) -> bool:
-    """Whether an edit would store what is stored already (same type and value)."""
-    if isinstance(value, (list, tuple)) and isinstance(stored, (list, tuple)):
-        return len(value) == len(stored) and all(_same(a, b) for a, b in zip(value, stored))
-    return type(value) is type(stored) and value == stored
 
 
 def _escape(text: str) -> str:

@@ -9,7 +9,8 @@ already detached, a moved node already sits at its new place); after every
 gesture `sync_edges` reconciles the scene with the document, which also
 reverts whatever the engine refused.  NodeGraphQt's own undo stack is never
 used.  The NodeGraphQt classes (node items, the gesture-forwarding graph)
-live in `ui.node_scene`, the "Arrange nodes" layout in `ui.node_layout`.
+live in `ui.node_scene`, the "Arrange nodes" layout in `ui.node_layout`; Tab search
+in `ui.node_search`, copy / paste in `ui.node_clipboard`, minimap and hint in `ui.node_minimap`.
 """
 
 from __future__ import annotations
@@ -26,7 +27,12 @@ from engine.graph import (AddNode, Connect, Disconnect, Edge, GraphDocument, Gra
 
 from .colours import family_shade
 from .node_layout import arrange_positions
+from .node_clipboard import NodeClipboard
+from .node_frames import NodeFrames
+from .node_minimap import NodeMinimap
 from .node_scene import DocumentNodeGraph, make_node_classes
+from .node_search import NodeSearch
+from .rich_text import doc_to_html
 
 FAMILY_ORDER = ("topology", "skeleton", "transform", "solid", "property")
 
@@ -77,6 +83,10 @@ class NodeEditor(QtWidgets.QWidget):
 
         doc.subscribe(self._on_doc_event)
         self.rebuild()
+        self.frames = NodeFrames(self)  # frames and subgraph boxes (ui.node_frames)
+        self.search = NodeSearch(self)  # Tab: search-to-add (ui.node_search)
+        self.clipboard = NodeClipboard(self)  # copy / paste / duplicate (ui.node_clipboard)
+        self.minimap = NodeMinimap(self)  # minimap and empty-editor hint (ui.node_minimap)
 
     # -- setup ------------------------------------------------------------
     def _disable_own_undo(self) -> None:
@@ -103,6 +113,9 @@ class NodeEditor(QtWidgets.QWidget):
                 sub.add_command(types[name].title or name,
                                 lambda _graph, _name=name: self.create_node(_name, self.menu_scene_pos))
         menu.add_separator()
+        menu.add_command("Copy", lambda _graph: self.clipboard.copy())
+        menu.add_command("Paste", lambda _graph: self.clipboard.paste(self.menu_scene_pos))
+        menu.add_command("Duplicate", lambda _graph: self.clipboard.duplicate())
         menu.add_command("Delete selected", lambda _graph: self.delete_selected())
         menu.add_command("Arrange nodes", lambda _graph: self.arrange_nodes())
         menu.add_command("Fit view", lambda _graph: self.fit_view())
@@ -110,6 +123,9 @@ class NodeEditor(QtWidgets.QWidget):
     def detach(self) -> None:
         """Stop listening to the document and to Tab (window closing)."""
         self.doc.unsubscribe(self._on_doc_event)
+        self.frames.detach()
+        self.minimap.detach()
+        self.search.detach()
         if self._tab_target is not None:
             self._tab_target.removeEventFilter(self)
             self._tab_target = None
@@ -119,7 +135,7 @@ class NodeEditor(QtWidgets.QWidget):
         if (watched is self._tab_target and event.type() == QtCore.QEvent.Type.KeyPress
                 and event.key() == QtCore.Qt.Key.Key_Tab
                 and event.modifiers() == QtCore.Qt.KeyboardModifier.NoModifier):
-            self.graph.toggle_node_search()
+            self.search.toggle_at_cursor()
             return True
         return super().eventFilter(watched, event)
 
@@ -251,9 +267,9 @@ class NodeEditor(QtWidgets.QWidget):
             return
         cls = all_node_types()[inst.type_name]
         lines = [f"<b>{cls.title or inst.type_name}</b> ({node_id}) — {cls.family}"]
-        doc = " ".join((cls.__doc__ or "").split())
+        doc = doc_to_html(cls.__doc__)
         if doc:
-            lines.append(f"<i>{_html_escape(doc)}</i>")
+            lines.append(doc)
         result = self._statuses.get(node_id)
         if result is not None:
             lines.append(f"status: <b>{result.status}</b> ({result.seconds:.2f} s)")
@@ -294,9 +310,10 @@ class NodeEditor(QtWidgets.QWidget):
             node.set_property("selected", True, push_undo=False)
         self._emit_selection()
 
-    def fit_view(self, margin: float = 40.0, min_zoom: float = 0.6) -> None:
-        """Zoom to show every node, between `min_zoom` (text stays readable) and 1:1."""
-        views = [n.view for n in self._by_id.values()]
+    def fit_view(self, margin: float = 40.0) -> None:
+        """Zoom to show every node, frame and collapsed subgraph (however many: no lower
+        zoom limit leaves any out), never closer than 1:1."""
+        views = [n.view for n in self._by_id.values() if n.view.isVisible()] + self.frames.items()
         viewer = self.graph.viewer()
         if not views:
             return
@@ -306,25 +323,26 @@ class NodeEditor(QtWidgets.QWidget):
         rect = rect.adjusted(-margin, -margin, margin, margin)
         size = viewer.viewport().size()
         w, h = max(size.width(), 50), max(size.height(), 50)
-        scale = min(w / rect.width(), h / rect.height())
-        scale = min(1.0, max(min_zoom, scale))
+        scale = min(1.0, w / rect.width(), h / rect.height())
         centre = rect.center()
         rect = QtCore.QRectF(0, 0, w / scale, h / scale)
         rect.moveCenter(centre)
         # NodeGraphQt keeps its zoom as a scene range fitted into the view.
         viewer._scene_range = rect
         viewer._update_scene()
+        self.minimap.refresh()
 
-    def arrange_nodes(self, *, column_width: float = 240.0, row_height: float = 100.0,
-                      columns: int | None = None) -> bool:
-        """Lay the graph out in columns by depth, wrapping into bands that fit the
-        editor's width; one undoable "arrange nodes" step.  False if nothing moved."""
-        if columns is None:
-            width = self.graph.viewer().viewport().width() / 0.8
-            columns = max(2, int(width // column_width))
-        positions = arrange_positions(self.doc, columns=columns, column_width=column_width, row_height=row_height)
-        if positions is None:
-            return False
+    def arrange_nodes(self, *, column_width: float | None = None,
+                      row_height: float | None = None) -> bool:
+        """Lay the graph out in readable columns (depth from the sources, rows ordered to
+        cross fewer edges, spacing from the largest node); one undoable "arrange nodes"
+        step, then the view fits the graph.  False if nothing moved."""
+        rects = [n.view.boundingRect() for n in self._by_id.values()]
+        if column_width is None:
+            column_width = max([240.0] + [r.width() + 70.0 for r in rects])
+        if row_height is None:
+            row_height = max([110.0] + [r.height() + 30.0 for r in rects])
+        positions = arrange_positions(self.doc, column_width=column_width, row_height=row_height)
         moves = [MoveNode(nid, pos) for nid, pos in positions.items()
                  if tuple(self.doc.nodes[nid].position) != pos]
         if not moves:

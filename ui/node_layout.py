@@ -1,31 +1,16 @@
-"""Where "Arrange nodes" puts the nodes: columns by depth, wrapped into bands."""
+"""Where "Arrange nodes" puts the nodes: `engine.graph.layout.layered_positions`
+over the document (columns by depth, rows ordered to cross fewer edges)."""
 
 from __future__ import annotations
 
-from engine.graph import GraphError
+from engine.graph.layout import layered_positions
 
 
-def arrange_positions(doc, *, columns: int, column_width: float = 240.0,
-                      row_height: float = 100.0) -> dict[str, tuple[float, float]] | None:
-    """``{node id: (x, y)}`` scene positions: a node's column is its depth (longest
-    path from a source), ``columns`` columns per band, bands stacked downwards;
-    None when the graph has a cycle."""
-    try:
-        order = doc.topological_order()
-    except GraphError:
-        return None
-    depth: dict[str, int] = {}
-    for nid in order:
-        depth[nid] = max((depth[e.src] + 1 for e in doc.inputs_of(nid) if e.src in depth), default=0)
-    levels: dict[int, list[str]] = {}
-    for nid in order:
-        levels.setdefault(depth[nid], []).append(nid)
-    positions, top = {}, 0.0
-    n_levels = max(levels, default=-1) + 1
-    for band_start in range(0, n_levels, columns):
-        band = [levels.get(d, []) for d in range(band_start, min(band_start + columns, n_levels))]
-        for k, ids in enumerate(band):
-            for r, nid in enumerate(ids):
-                positions[nid] = (k * column_width, top + r * row_height)
-        top += max(len(ids) for ids in band) * row_height + 0.6 * row_height
-    return positions
+def arrange_positions(doc, *, column_width: float = 240.0,
+                      row_height: float = 110.0) -> dict[str, tuple[float, float]]:
+    """``{node id: (x, y)}`` scene positions for every node of ``doc``; the nodes
+    keep their relative vertical order where crossings allow (input order is the
+    order of their current y, then x)."""
+    ids = sorted(doc.nodes, key=lambda n: (doc.nodes[n].position[1], doc.nodes[n].position[0], n))
+    edges = [(e.src, e.dst) for e in doc.edges]
+    return layered_positions(ids, edges, column_width=column_width, row_height=row_height)

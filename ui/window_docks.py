@@ -17,6 +17,7 @@ from .node_editor import NodeEditor
 from .phasor_panel import PhasorPanel
 from .rd_panel import RDPanel
 from .study_panel import StudyPanel
+from .subgraph_inspector import SubgraphPanel
 from .surface_panel import SurfacePanel
 from .tileset_editor import TileSetEditor
 from .viewport import Viewport
@@ -38,11 +39,20 @@ class WindowDocks:
         self.setCentralWidget(self.viewport)
 
         self.editor = NodeEditor(self.doc, self.undo, self)
+        # copies carry the stateful nodes' latest results, and the evaluator takes a paste's
+        self.editor.clipboard.state_source = self.worker.evaluator.export_state
+        self.editor.clipboard.state_sink = self.worker.evaluator.add_state
         self.editor_dock = self._dock("Node graph", self.editor, scroll=False)
         self.editor.setMinimumWidth(EDITOR_MIN_WIDTH)
 
         self.inspector = Inspector(self.doc, self.undo, self)
-        self.inspector_dock = self._dock("Inspector", self.inspector)
+        # under the node's parameters: the frame or subgraph clicked, or the one the node is in
+        self.subgraph_panel = SubgraphPanel(self.doc, self.undo, self.editor.frames, self)
+        self.subgraph_panel.message.connect(self.log)
+        self.inspector_dock = self._dock("Inspector", _stacked(self.inspector, self.subgraph_panel))
+        self.editor.frames.picked.connect(lambda _item: self.inspector_dock.raise_())
+        self.subgraph_panel.setVisible(self.editor.frames.current is not None)
+        self.editor.frames.current_changed.connect(lambda cur: self.subgraph_panel.setVisible(cur is not None))
         self.growth_panel = GrowthPanel(self, undo=self.undo)
         self.growth_dock = self._dock("Virtual Growth", self.growth_panel)
         self.tileset_editor = TileSetEditor(self.doc, self.undo, self)
@@ -115,3 +125,14 @@ def scrolled(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
     area.setWidget(widget)
     area.setMinimumSize(SCROLL_MIN_WIDTH, SCROLL_MIN_HEIGHT)
     return area
+
+
+def _stacked(*widgets: QtWidgets.QWidget) -> QtWidgets.QWidget:
+    """`widgets` one above the other in one dock, the slack below them."""
+    box = QtWidgets.QWidget()
+    lay = QtWidgets.QVBoxLayout(box)
+    lay.setContentsMargins(0, 0, 0, 0)
+    for w in widgets:
+        lay.addWidget(w)
+    lay.addStretch(1)
+    return box

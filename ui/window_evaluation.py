@@ -12,7 +12,7 @@ class WindowEvaluation:
 
     # -- document events -> evaluation ---------------------------------------------------
     def _on_doc_event(self, event: str, payload) -> None:
-        if event in ("node_moved", "label_changed"):
+        if event in ("node_moved", "label_changed", "annotation_changed"):
             return  # layout only: results cannot change
         if event == "node_removed" and payload == self.shown_stiffness_id:
             self.update_viewport()  # its material sphere goes now, not after the next evaluation

@@ -6,6 +6,9 @@ from pathlib import Path
 
 from PySide6 import QtGui, QtWidgets
 
+from .example_gallery import show_gallery
+from .help_dialogs import build_help_menu
+from .subgraph_actions import build_annotation_actions, fill_edit_menu
 from .undo_keys import REDO_KEYS, UNDO_KEYS, UndoKeys
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "resources" / "examples"
@@ -44,7 +47,12 @@ class WindowMenus:
         self.act_undo.setShortcuts(list(UNDO_KEYS))
         self.act_redo.setShortcuts(list(REDO_KEYS))
         self.undo_keys = UndoKeys(self, self.undo_edit, self.redo_edit)
+        # node copy / paste / duplicate (ui.node_clipboard); text fields keep their own Ctrl+C / Ctrl+V
+        self.act_copy = self._action("&Copy Nodes", self.editor.clipboard.copy, K.Copy)
+        self.act_paste = self._action("&Paste Nodes", self.editor.clipboard.paste, K.Paste)
+        self.act_duplicate = self._action("D&uplicate Nodes", self.editor.clipboard.duplicate, "Ctrl+D")
         self.act_delete = self._action("&Delete Node", self.editor.delete_selected, K.Delete)
+        build_annotation_actions(self)  # frames and subgraphs (ui.subgraph_actions)
         self.act_tiling = self._action("Tile 3×3×3", lambda on: self.viewport.set_tiling(3 if on else 1),
                                        "T", checkable=True)
         self.act_skeleton = self._action("Show &Skeleton", self.viewport.set_show_skeleton, checkable=True,
@@ -58,6 +66,7 @@ class WindowMenus:
         self.act_evaluate = self._action("&Evaluate Now", self.evaluate_now, "F5")
         self.act_auto = self._action("&Auto-evaluate", self._on_auto_toggled, checkable=True, checked=True)
         self.act_cancel = self._action("&Cancel Evaluation", self.cancel_evaluation, "Ctrl+.")
+        self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
 
     def _build_menus(self) -> None:
         bar = self.menuBar()
@@ -67,6 +76,8 @@ class WindowMenus:
         self.examples_menu = file_menu.addMenu("Open &Example")
         self.examples_menu.aboutToShow.connect(self._fill_examples_menu)
         self._fill_examples_menu()
+        self.act_gallery = self._action("Example &Gallery…", lambda: show_gallery(self), "Ctrl+Shift+O")
+        file_menu.addAction(self.act_gallery)          # thumbnails, families, summaries (ui.example_gallery)
         file_menu.addSeparator()
         file_menu.addAction(self.act_save)
         file_menu.addAction(self.act_save_as)
@@ -78,7 +89,10 @@ class WindowMenus:
         edit_menu.addAction(self.act_undo)
         edit_menu.addAction(self.act_redo)
         edit_menu.addSeparator()
+        for action in (self.act_copy, self.act_paste, self.act_duplicate):
+            edit_menu.addAction(action)
         edit_menu.addAction(self.act_delete)
+        fill_edit_menu(self, edit_menu)
 
         view_menu = bar.addMenu("&View")
         tiling = view_menu.addMenu("Tiling")
@@ -103,11 +117,13 @@ class WindowMenus:
         docks = view_menu.addMenu("Docks")           # every dock, by title
         for dock in sorted(self.findChildren(QtWidgets.QDockWidget), key=lambda d: d.windowTitle()):
             docks.addAction(dock.toggleViewAction())
+        view_menu.addAction(self.act_reset_layout)     # every dock back in its default place
 
         eval_menu = bar.addMenu("E&valuate")
         eval_menu.addAction(self.act_evaluate)
         eval_menu.addAction(self.act_auto)
         eval_menu.addAction(self.act_cancel)
+        build_help_menu(self, bar)      # Help › Shortcuts / About, then tips on every action (ui.help_dialogs)
 
     def _fill_examples_menu(self) -> None:
         self.examples_menu.clear()

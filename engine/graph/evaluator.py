@@ -214,6 +214,27 @@ class Evaluator:
             self._pending = entries
         return warnings
 
+    def add_state(self, states: dict[str, Any]) -> list[str]:
+        """Take stored results for nodes that hold none (pasted nodes), keeping
+        everything held and the cache (no other node's result can change).
+
+        An entry for a node that already holds a result is left out, as is a
+        malformed one; the returned list says which and why.
+        """
+        warnings = []
+        with self._state_lock:
+            target = self._pending if self._pending is not None else self._stored
+            for nid, entry in (states or {}).items():
+                nid = str(nid)
+                if nid in self._state or nid in target:
+                    warnings.append(f"node {nid!r}: holds a result already; stored state not taken")
+                    continue
+                try:
+                    target[nid] = parse_state_entry(entry)
+                except ValueError as exc:
+                    warnings.append(f"node {nid!r}: stored state dropped: {exc}")
+        return warnings
+
     def export_state(self) -> dict[str, dict]:
         """``{node_id: {"key", "params", "seed", "value"}}`` for every stateful
         node result held, including imported ones no evaluation has used yet.

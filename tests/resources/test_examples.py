@@ -6,6 +6,10 @@ input) must be a closed mesh that tiles: the single-cell mesh matches across
 opposite faces, and a 2x2x2 block is one closed, connected piece.  The node
 count must stay within +-30% of the paper's Table 4 (Makatura et al. 2023),
 and the files must be exactly what ``tools/make_examples.py`` writes.
+
+Every example (cells, shells, properties, growth, phasor, RD) carries a
+family and a one-line summary for the gallery and ships laid out in columns;
+the property and growth examples evaluate to a stiffness tensor.
 """
 
 from __future__ import annotations
@@ -22,8 +26,6 @@ from engine.graph import load_project
 
 from .example_files import EXAMPLES_DIR, evaluate_at, load_tool
 
-FILES = sorted(p for p in EXAMPLES_DIR.glob("*.json")
-               if not p.stem.startswith(("phasor_", "rd_", "tpms_")))  # unit cells
 TEST_RESOLUTION = 48
 
 # Table 4, column #all.  BCC is not in the paper; 12 is our own reference
@@ -41,6 +43,8 @@ PAPER_NODE_COUNT = {
     "six_hole_bcc": 27,      # "6-hole BCC"
     "bandgap": 30,
 }
+ALL_FILES = sorted(EXAMPLES_DIR.glob("*.json"))
+FILES = sorted(p for p in ALL_FILES if p.stem in PAPER_NODE_COUNT)  # unit cells
 VOLUME_FRACTION_BAND = (0.02, 0.6)
 
 
@@ -78,15 +82,17 @@ def example(request):
 
 def test_every_generated_example_is_present():
     generator = _load_generator()
-    assert sorted(p.stem for p in FILES) == sorted(generator.EXAMPLES)
+    every = sorted(n if n in generator.EXAMPLES or not n in generator.SURFACE_EXAMPLES else "tpms_" + n
+                   for builders, _ in generator.all_writers().values() for n in builders)
+    assert sorted(p.stem for p in ALL_FILES) == every
     assert sorted(PAPER_NODE_COUNT) == sorted(generator.EXAMPLES)
 
 
 def test_files_are_what_the_generator_writes(tmp_path):
     generator = _load_generator()
-    generator.write_examples(tmp_path)
+    generator.write_all(tmp_path)
     fresh = {p.name: json.loads(p.read_text()) for p in sorted(tmp_path.glob("*.json"))}
-    stored = {p.name: json.loads(p.read_text()) for p in FILES}
+    stored = {p.name: json.loads(p.read_text()) for p in ALL_FILES}
     assert sorted(fresh) == sorted(stored)
     for name in fresh:
         assert fresh[name] == stored[name], f"{name} differs from tools/make_examples.py: regenerate it"
@@ -156,3 +162,112 @@ def test_tiled_block_is_one_closed_piece(example):
     assert _components(mesh) == 1, f"{name}: 2x2x2 block falls apart"
     single = _mesh(solid.vertices, solid.faces)
     assert mesh.volume == pytest.approx(8.0 * single.volume, rel=1e-3)
+
+
+# ----------------------------------------------------------------- every example: gallery and layout
+
+@pytest.mark.parametrize("path", ALL_FILES, ids=[p.stem for p in ALL_FILES])
+def test_meta_names_family_and_one_line_summary(path):
+    catalogue = load_tool("example_catalogue")
+    meta = load_project(path).meta
+    assert meta["family"] in catalogue.FAMILIES, f"{path.stem}: family {meta.get('family')!r}"
+    summary = meta["summary"]
+    assert summary and "\n" not in summary and len(summary) <= 100, f"{path.stem}: summary {summary!r}"
+    assert meta["title"] and meta["description"]
+
+
+def test_every_family_has_an_example():
+    catalogue = load_tool("example_catalogue")
+    families = {load_project(p).meta["family"] for p in ALL_FILES}
+    assert families == set(catalogue.FAMILIES)
+
+
+@pytest.mark.parametrize("path", ALL_FILES, ids=[p.stem for p in ALL_FILES])
+def test_layout_is_readable_columns(path):
+    """Every edge runs left to right, no two nodes share a place, and a column
+    holds nodes of one depth (engine.graph.layout)."""
+    doc = load_project(path)
+    places = [tuple(n.position) for n in doc.nodes.values()]
+    assert len(set(places)) == len(places), f"{path.stem}: nodes on top of each other"
+    for e in doc.edges:
+        assert doc.node(e.src).position[0] < doc.node(e.dst).position[0], f"{path.stem}: {e.src} -> {e.dst}"
+    rows_per_column: dict[float, set] = {}
+    for x, y in places:
+        rows_per_column.setdefault(x, set()).add(y)
+    assert all(len(ys) == sum(1 for p in places if p[0] == x) for x, ys in rows_per_column.items())
+
+
+# ----------------------------------------------------------------- property and growth examples
+
+PROPERTY_FILES = [EXAMPLES_DIR / "octet_stiffness.json", EXAMPLES_DIR / "schwarz_p_stiffness.json"]
+GROWTH_FILES = sorted(EXAMPLES_DIR.glob("growth_*.json"))
+PROPERTY_TEST_RESOLUTION = 24       # Object grid and solve grid: enough for a cubic C
+
+
+def _stiffness_nodes(doc, type_name):
+    return [nid for nid, node in doc.nodes.items() if node.type_name == type_name]
+
+
+@pytest.mark.parametrize("path", PROPERTY_FILES, ids=[p.stem for p in PROPERTY_FILES])
+def test_property_example_gives_a_cubic_stiffness(path):
+    from engine.graph import Evaluator, SetParam, UndoStack
+    from engine.physics.values import Stiffness
+
+    doc = load_project(path)
+    (mm,) = _stiffness_nodes(doc, "MaterialMatrix")
+    stack = UndoStack(doc)
+    for nid, node in doc.nodes.items():
+        if node.type_name == "Object":
+            stack.push(SetParam(nid, "resolution", PROPERTY_TEST_RESOLUTION))
+    stack.push(SetParam(mm, "resolution", PROPERTY_TEST_RESOLUTION))
+    report = Evaluator().evaluate(doc)
+    assert report.ok, report.errors
+    stiffness = report.outputs[mm]["stiffness"]
+    assert isinstance(stiffness, Stiffness)
+    C = np.asarray(stiffness.C)
+    assert C.shape == (6, 6) and np.allclose(C, C.T, atol=1e-8 * abs(C).max())
+    assert np.all(np.linalg.eigvalsh(C) > 0)          # a connected cell carries load every way
+    # both cells have the cube's symmetry: C11 = C22 = C33 to discretisation
+    assert np.ptp(np.diag(C)[:3]) < 0.05 * C[0, 0]
+    assert 0.0 < stiffness.density < 1.0
+
+
+def test_growth_examples_are_present():
+    assert len(GROWTH_FILES) >= 3
+    assert any(len(load_project(p).node("grow").params["size"]) == 3 for p in GROWTH_FILES)
+
+
+@pytest.mark.parametrize("path", GROWTH_FILES, ids=[p.stem for p in GROWTH_FILES])
+def test_growth_example_grows_and_gives_tiling_properties(path):
+    from engine.graph import Evaluator
+    from engine.physics.values import Stiffness
+
+    doc = load_project(path)
+    (grow,) = _stiffness_nodes(doc, "Grow")
+    (props,) = _stiffness_nodes(doc, "TilingProperties")
+    assert [e.src for e in doc.inputs_of(props)] == [grow]     # the growth dock finds it downstream
+    report = Evaluator().evaluate(doc)
+    assert report.ok, report.errors
+    tiling = report.outputs[grow]["tiling"].tiling
+    assert tuple(tiling.shape[::-1]) == tuple(doc.node(grow).params["size"]) or \
+        tuple(tiling.shape) == tuple(doc.node(grow).params["size"])
+    stiffness = report.outputs[props]["stiffness"]
+    assert isinstance(stiffness, Stiffness)
+    C = np.asarray(stiffness.C)
+    assert C.shape == ((3, 3) if len(doc.node(grow).params["size"]) == 2 else (6, 6))
+    assert np.all(np.linalg.eigvalsh(0.5 * (C + C.T)) > 0)
+    assert 0.0 < stiffness.density < 1.0
+
+
+def test_hints_change_the_grown_mix():
+    """The hinted example asks for more + and - blocks than the set's weights and gets them."""
+    from engine.graph import Evaluator
+    from engine.growth.hints import realised_probabilities
+
+    share = {}
+    for stem in ("growth_tl_2d", "growth_tl_hints"):
+        tv = Evaluator().evaluate(load_project(EXAMPLES_DIR / f"{stem}.json")).outputs["grow"]["tiling"]
+        p = realised_probabilities(tv.tiling, tv.tileset)
+        names = list(tv.tileset.block_names)
+        share[stem] = p[names.index("+")] + p[names.index("-")]
+    assert share["growth_tl_hints"] > share["growth_tl_2d"] + 0.05

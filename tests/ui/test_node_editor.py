@@ -139,11 +139,15 @@ def test_reset_rebuilds_scene(window, strut_graph):
 def test_arrange_nodes_is_one_undo_step(window, strut_graph):
     ids = strut_graph(window.undo)
     before = {nid: n.position for nid, n in window.doc.nodes.items()}
-    assert window.editor.arrange_nodes(columns=3)
+    assert window.editor.arrange_nodes()
     after = {nid: n.position for nid, n in window.doc.nodes.items()}
     assert after[ids["v1"]][0] == after[ids["v2"]][0] == 0.0       # sources share the first column
-    assert after[ids["e"]][0] > after[ids["v1"]][0]
-    assert after[ids["obj"]][1] > after[ids["v1"]][1]               # depth 3 wraps into a second band
+    xs = [after[ids[k]][0] for k in ("v1", "e", "l", "obj", "vox")]
+    assert xs == sorted(set(xs))                                   # one column per depth, left to right
+    for e in window.doc.edges:
+        assert after[e.src][0] < after[e.dst][0]
+    rects = [window.editor.scene_node(n).view.sceneBoundingRect() for n in after]
+    assert not any(a.intersects(b) for i, a in enumerate(rects) for b in rects[i + 1:])
     assert window.editor.scene_node(ids["obj"]).pos() == list(after[ids["obj"]])
     assert window.undo.undo_text() == "arrange nodes"
     window.undo_edit()

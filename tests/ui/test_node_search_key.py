@@ -8,7 +8,7 @@ from PySide6 import QtCore
 def test_tab_in_the_graph_view_toggles_node_search(window, qtbot, monkeypatch):
     editor = window.editor
     calls = []
-    monkeypatch.setattr(editor.graph, "toggle_node_search", lambda: calls.append(1))
+    monkeypatch.setattr(editor.search, "toggle_at_cursor", lambda: calls.append(1))
     view = editor.graph.viewer()
     view.setFocus()
     qtbot.keyClick(view, QtCore.Qt.Key.Key_Tab)

@@ -156,3 +156,41 @@ def test_refusals_change_nothing():
 def test_clipboard_text_that_is_no_fragment_is_refused(text, match):
     with pytest.raises(GraphError, match=match):
         fragment_from_text(text)
+
+
+def test_a_pasted_grow_keeps_its_copied_repainted_tiling_when_the_evaluator_takes_its_state():
+    """Stored results travel with a copy: the evaluator's latest state is copied, and
+    `Evaluator.add_state` hands the pasted node its copy (without emptying the cache)."""
+    import numpy as np
+
+    from engine.graph import Evaluator, SetParam
+    from engine.growth.regions import format_region_map
+
+    doc = GraphDocument(seed=4)
+    st = UndoStack(doc)
+    st.push(AddNode("TileSet", node_id="ts", position=(0, 0)))
+    st.push(AddNode("Grow", {"size": [12, 12], "seed": 77}, node_id="g", position=(240, 0)))
+    st.push(Connect("ts", "tileset", "g", "tileset"))
+    ev = Evaluator()
+    first = np.array(ev.evaluate(doc).output("g").tiling.tiles)
+    labels = np.zeros((12, 12), int)
+    labels[4:8, 4:8] = 1
+    st.push(SetParam("g", "region_hints", "1: +=50,T=1,L=1,-=1"))
+    st.push(SetParam("g", "regions", format_region_map(labels)))
+    regrown = np.array(ev.evaluate(doc).output("g").tiling.tiles)
+    assert not np.array_equal(regrown, first)
+
+    fragment = fragment_of(doc, ["ts", "g"], node_state=ev.export_state())
+    assert set(fragment["node_state"]) == {"g"}
+    cmd = PasteFragment(fragment, offset=(0, 300))
+    st.push(cmd)
+    g2 = cmd.id_map["g"]
+    assert ev.add_state({g2: doc.node_state[g2]}) == []
+    assert ev.add_state({"g": doc.node_state[g2]})          # a node holding a result keeps it
+    report = ev.evaluate(doc)
+    assert report.results["g"].status == "cached"              # the cache survived
+    pasted = np.array(report.output(g2).tiling.tiles)
+    assert pasted.tobytes() == regrown.tobytes()
+    # without the copied state the pasted node grows afresh: the same parameters, no repaint history
+    fresh = Evaluator().evaluate(doc).output(g2).tiling.tiles
+    assert not np.array_equal(np.array(fresh), regrown)
