@@ -242,4 +242,5 @@ class MainWindow(WindowDocks, WindowLayout, WindowMenus, WindowEvaluation, Windo
         self.study_panel.shutdown()
         self.doc.unsubscribe(self._on_doc_event)
         self.autosave.clear()
+        self.stop_export()
         self.viewport.close_plotter()

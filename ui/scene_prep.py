@@ -2,13 +2,12 @@
 
 Plain functions (numpy + pyvista data objects, no Qt, no render window), so a
 `ui.task_runner.TaskRunner` can run them in a worker thread: the GUI thread
-then only swaps the finished `pyvista.PolyData` into its actor.
+then only hands the finished arrays to its actors.
 
-Smooth shading needs point normals.  They are computed once per solid, on the
-single cell, with numpy (area-weighted face normals summed at each vertex),
-and a 3x3x3 tiling reuses them: a translated copy has the same normals, and
-the tiled mesh does not merge vertices across tile seams, so these are
-exactly the normals a normals filter would compute on the merged mesh.
+Smooth shading needs point normals.  They are computed once per solid and
+level of detail, on the single cell, with numpy (area-weighted face normals
+summed at each vertex); a tiling draws translated copies of the cell
+(`ui.solid_actors`), which have the same normals.
 """
 
 from __future__ import annotations
@@ -17,14 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyvista as pv
-
-# rows per chunk of the tiling copy: numpy releases the GIL on big copies,
-# and chunks let a superseded preparation stop early
-TILE_CHUNK = 4
-# a tiled view draws at most about this many triangles: finer cells are
-# decimated for the tiling (the software renderer spends ~0.3 us a triangle;
-# at 3x3x3 a cell spans ~100 pixels, so the full mesh is far below a pixel)
-TILED_TRIANGLE_BUDGET = 400_000
 
 
 @dataclass(frozen=True)
@@ -59,41 +50,6 @@ def prepare_cell(vertices: np.ndarray, faces: np.ndarray) -> PreparedCell:
     v = np.ascontiguousarray(vertices, dtype=np.float32)
     f = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
     return PreparedCell(v, f, point_normals(v, f))
-
-
-def cell_for_tiling(cell: PreparedCell, copies: int, budget: int = TILED_TRIANGLE_BUDGET) -> PreparedCell:
-    """`cell` itself if `copies` of it fit the triangle `budget`, else a decimated copy
-    (quadric decimation, boundary edges constrained so the tiles still meet) that does."""
-    m = len(cell.faces)
-    if copies <= 1 or copies * m <= budget or m < 64:
-        return cell
-    reduction = 1.0 - budget / float(copies * m)
-    mesh = pv.PolyData.from_regular_faces(cell.vertices, cell.faces)
-    coarse = mesh.decimate(reduction, boundary_constraints=True)
-    faces = np.asarray(coarse.regular_faces, dtype=np.int64)
-    return prepare_cell(np.asarray(coarse.points), faces) if len(faces) else cell
-
-
-def tiled_polydata(cell: PreparedCell, offsets: np.ndarray, check=None) -> pv.PolyData:
-    """One merged mesh of the cell translated by each row of `offsets` (k, 3) mm,
-    with the cell's point normals as the active "Normals".
-
-    check : optional callable() run between chunks (raises to stop, e.g.
-        `Task.check`)."""
-    offsets = np.asarray(offsets, dtype=np.float32).reshape(-1, 3)
-    n, m, k = len(cell.vertices), len(cell.faces), len(offsets)
-    points = np.empty((k * n, 3), np.float32)
-    faces = np.empty((k * m, 3), np.int64)
-    for start in range(0, k, TILE_CHUNK):
-        if check is not None:
-            check()
-        for i in range(start, min(k, start + TILE_CHUNK)):
-            np.add(cell.vertices, offsets[i], out=points[i * n:(i + 1) * n])
-            np.add(cell.faces, i * n, out=faces[i * m:(i + 1) * m])
-    mesh = pv.PolyData.from_regular_faces(points, faces)
-    mesh.point_data["Normals"] = np.tile(cell.normals, (k, 1)) if k > 1 else cell.normals
-    mesh.point_data.active_normals_name = "Normals"
-    return mesh
 
 
 def skeleton_polydata(polylines: list[np.ndarray]) -> pv.PolyData | None:

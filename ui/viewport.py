@@ -3,9 +3,11 @@
 A thin adapter over a pyvistaqt `QtInteractor`.  The scene is kept by actor
 (`ui.scene.SceneActors`): a new state replaces only the actors whose value
 changed, so selecting another node that shows the same solid touches
-nothing.  A solid's render mesh (normals, the merged 3x3x3 tiling) is
-prepared off the GUI thread in a `TaskRunner` (`ui.scene_prep`) and kept per
-solid and tiling; the GUI thread only swaps it into the actor.  What to show
+nothing.  A solid is drawn as tiles sharing one mesh (`ui.solid_actors`) at
+a level of detail chosen every frame from its size on screen and whether the
+camera moves (`ui.scene_lod`); the levels (normals, decimated cells) are
+prepared off the GUI thread in a `TaskRunner` and kept for the last
+`KEPT_SOLIDS` solids, so switching the tiling uploads nothing.  What to show
 is decided by the plain functions of `ui.view_content`, re-exported here.
 """
 
@@ -16,7 +18,6 @@ from typing import Any, Callable
 
 import numpy as np
 import pyvista as pv
-from pyvistaqt import QtInteractor
 from PySide6 import QtCore, QtWidgets
 
 from engine.fab import vtk_line_cells
@@ -24,8 +25,11 @@ from engine.geometry.values import Skeleton, Solid
 from engine.physics.values import Stiffness
 
 from .qt_wait import process_events_until
+from .render_widget import StampedInteractor
 from .scene import MIN_FRAMED_PIXELS, Framing, SceneActors
-from .scene_prep import cell_for_tiling, prepare_cell, skeleton_polydata, surfaces_polydata, tiled_polydata
+from .scene_prep import skeleton_polydata, surfaces_polydata
+from .solid_actors import SolidActors
+from .viewport_solid import ViewportSolid, same_key
 from .task_runner import TaskRunner
 from .view_content import (BOX_COLOUR, LINE_COLOUR, POINT_COLOUR, SOLID_COLOUR, SPHERE_BAR_TITLE, SPHERE_CMAP,
                            SPHERE_GAP, SPHERE_RADIUS, SPHERE_SUBDIVISIONS, SURFACE_COLOUR, block_bounds,
@@ -42,19 +46,21 @@ HINT = "nothing to show yet: evaluate a graph with a solid or skeleton node"
 SKELETON_ACTORS = ("skeleton_lines", "skeleton_surfaces", "control_points")
 
 
-class Viewport(QtWidgets.QWidget):
+class Viewport(ViewportSolid, QtWidgets.QWidget):
     """Shows a Solid (tiled 1x1x1 or 3x3x3), a Skeleton, the unit-cell box, a
     material sphere and overlays (toolpaths) owned by the node that made them.
 
-    Signals: ``scene_ready()`` once a prepared solid mesh is in its actor."""
+    Signals: ``scene_ready()`` once a prepared solid mesh is in its actor; ``closing()``
+    when `close_plotter` starts (the window is shutting down)."""
 
     scene_ready = QtCore.Signal()
+    closing = QtCore.Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
         layout = QtWidgets.QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        self.plotter = QtInteractor(self)
+        self.plotter = StampedInteractor(self)   # repaints of an unchanged scene do not render
         layout.addWidget(self.plotter.interactor)
         # 4x MSAA triples the software renderer's frame time; lines are drawn as tubes anyway
         self.plotter.render_window.SetMultiSamples(0)
@@ -75,15 +81,21 @@ class Viewport(QtWidgets.QWidget):
         self.toolpaths: pv.PolyData | None = None
         self.toolpath_owner: Any = None
         self.overlay_owner: Callable[[], Any] | None = None  # who owns a new overlay (set by the window)
-        self.prepared = 0                 # solid meshes prepared (off the GUI thread)
+        self.prepared = 0                 # solids whose levels of detail were all prepared (off the GUI thread)
         self._failed: tuple | None = None    # the (solid, tiles) whose preparation failed
         self._closed = False
+        self._render_pending = False      # a frame is asked for (`request_render`)
         self._sphere_points = 0
+        self._sphere_base: tuple[bytes | None, Any] = (None, None)   # (C bytes, unscaled surface of C)
         self._sphere_note = ""
         self._wanted_solid: tuple | None = None         # (solid, tiles) the solid actor should show
-        self._mesh_cache: tuple[Solid | None, Any, dict] = (None, None, {})  # solid, PreparedCell, {tiles: mesh}
+        self._views: list[tuple[Solid, SolidActors]] = []   # prepared solids, newest last
+        self._view: SolidActors | None = None           # the one in the renderer
+        self.solid_prop = pv.Property(color=SOLID_COLOUR, specular=0.25, interpolation="phong")
+        self.plotter.renderer.AddObserver("StartEvent", self._before_frame)
         self._prep = TaskRunner(self)
-        self._prep.finished.connect(self._on_prepared)
+        self._prep.published.connect(self._on_partial)
+        self._prep.finished.connect(self._on_done)
         self._prep.failed.connect(self._on_prep_failed)
         self.redraw()
 
@@ -158,8 +170,12 @@ class Viewport(QtWidgets.QWidget):
         return len(solid.vertices) * tiles ** 3
 
     def shown_mesh_point_count(self) -> int:
-        actor = self.scene.actor("solid")
-        return 0 if actor is None else int(actor.GetMapper().GetInput().GetNumberOfPoints())
+        """Points the solid's visible tiles draw now (at the current level of detail)."""
+        return 0 if self._view is None else self._view.drawn_points()
+
+    def solid_view(self) -> SolidActors | None:
+        """The tiles of the solid in the renderer (None if no solid is drawn)."""
+        return self._view
 
     def cell_size(self) -> float:
         return float(self.solid.cell_size) if self.solid is not None else 1.0
@@ -170,10 +186,15 @@ class Viewport(QtWidgets.QWidget):
 
     @property
     def is_ready(self) -> bool:
-        """Nothing is being prepared and the solid actor shows what it should."""
+        """Nothing is being prepared, no frame is waiting and the solid shows what it should."""
         wanted = self._wanted_solid
-        return not self._prep.is_busy and (wanted is None or self.scene.same("solid", wanted)
-                                           or _same(wanted, self._failed))
+        shown = wanted is None or self.scene.same("solid", wanted) or same_key(wanted, self._failed)
+        return shown and not self._prep.is_busy and not self._render_pending
+
+    def _before_frame(self, *_args) -> None:
+        """Renderer StartEvent: the solid's level of detail for this frame."""
+        if self._view is not None:
+            self._view.choose()
 
     def wait_ready(self, timeout_ms: int = 60000) -> bool:
         """Process events until `is_ready` (tests, screenshots)."""
@@ -190,6 +211,19 @@ class Viewport(QtWidgets.QWidget):
         finally:
             self.plotter.suppress_rendering = False
         if self._frame() or changed:
+            self.request_render()
+
+    def request_render(self) -> None:
+        """Render once, after the events being handled now: the changes of one gesture
+        (selection, inspector, docks) coalesce into one frame, and the frame does not
+        add to the time of the handler that asked for it."""
+        if not self._render_pending:
+            self._render_pending = True
+            QtCore.QTimer.singleShot(0, self, self._render_now)   # dropped if the widget goes first
+
+    def _render_now(self) -> None:
+        if self._render_pending and not self._closed:
+            self._render_pending = False
             self.plotter.render()
 
     def _sync_scene(self) -> bool:
@@ -216,80 +250,6 @@ class Viewport(QtWidgets.QWidget):
             return self.scene.drop(name)
         return self.scene.put(name, (text,), lambda: self.plotter.add_text(
             text, position=position, font_size=9, color=colour, name=name))
-
-    def _sync_solid(self, tiles: int) -> bool:
-        solid = self.solid
-        if not (self.show_solid and solid is not None and len(solid.faces)):
-            self._wanted_solid = None
-            self._prep.cancel()
-            return self.scene.drop("solid")
-        key = (solid, tiles)
-        self._wanted_solid = key
-        if self.scene.same("solid", key):
-            return self._set_solid_opacity()
-        cached, cell, meshes = self._mesh_cache
-        if cached is solid and tiles in meshes:
-            self._prep.cancel()
-            self._swap_solid(key, meshes[tiles])
-            return True
-        if _same(key, self._failed):
-            return False
-        running = self._prep.running
-        if running is not None and _same(running.data, key) and self._prep.pending is None:
-            return False
-        cell = cell if cached is solid else None
-        offsets = tile_offsets(tiles, solid.box)
-        self._prep.submit(lambda task: _prepare_solid(task, solid, cell, offsets), data=key)
-        return False
-
-    def _set_solid_opacity(self) -> bool:
-        actor = self.scene.actor("solid")
-        if actor is None:
-            return False
-        translucent = self.show_skeleton and self.skeleton is not None and self.skeleton_emphasis
-        opacity = 0.35 if translucent else 1.0
-        if actor.prop.opacity == opacity:
-            return False
-        actor.prop.opacity = opacity
-        return True
-
-    def _swap_solid(self, key: tuple, mesh: pv.PolyData) -> None:
-        """Show the prepared `mesh`: a new input for the existing actor (cheap), or the first actor."""
-        actor = self.scene.actor("solid")
-
-        def build():
-            if actor is not None:
-                actor.mapper.SetInputData(mesh)
-                return actor
-            new = self.plotter.add_mesh(mesh, color=SOLID_COLOUR, specular=0.25, name="solid",
-                                        reset_camera=False)
-            new.prop.interpolation = "phong"   # the prepared point normals give smooth shading
-            return new
-
-        self.scene.put("solid", key, build)
-        self._set_solid_opacity()
-
-    def _on_prepared(self, task, result) -> None:
-        if self._closed:
-            return
-        solid, tiles = task.data
-        cell, mesh = result
-        self.prepared += 1
-        cached, _, meshes = self._mesh_cache
-        if cached is not solid:
-            meshes = {}
-        meshes[tiles] = mesh
-        self._mesh_cache = (solid, cell, meshes)
-        if _same(task.data, self._wanted_solid):
-            self._swap_solid(task.data, mesh)
-            self._frame()
-            self.plotter.render()
-            self.scene_ready.emit()
-
-    def _on_prep_failed(self, task, message: str) -> None:
-        self._failed = task.data
-        self.caption = f"{self.caption}\nsolid not drawn: {message}".strip()
-        self.redraw()
 
     def _sync_skeleton(self) -> bool:
         skeleton = self.skeleton if self.show_skeleton else None
@@ -345,9 +305,14 @@ class Viewport(QtWidgets.QWidget):
 
     def _draw_material_sphere(self, C: np.ndarray, box: np.ndarray):
         self._sphere_points, self._sphere_note = 0, ""
-        try:
-            base = stiffness_polydata(C)
-        except ValueError:
+        key = C.tobytes()
+        if self._sphere_base[0] != key:         # the surface of C is kept: a new tiling only moves it
+            try:
+                self._sphere_base = (key, stiffness_polydata(C))
+            except ValueError:
+                self._sphere_base = (key, None)
+        base = self._sphere_base[1]
+        if base is None:
             self._sphere_note = "material sphere: none, C is singular (the cell is a mechanism)"
             return None
         radii = np.linalg.norm(base.points, axis=1)
@@ -366,7 +331,8 @@ class Viewport(QtWidgets.QWidget):
 
     # -- camera ------------------------------------------------------------------------
     def _has_content(self) -> bool:
-        return any(self.scene.actor(n) is not None for n in ("solid", "toolpaths", *SKELETON_ACTORS))
+        return self._view is not None or any(self.scene.actor(n) is not None
+                                             for n in ("toolpaths", *SKELETON_ACTORS))
 
     def _sized(self) -> bool:
         w = self.plotter.interactor
@@ -384,9 +350,11 @@ class Viewport(QtWidgets.QWidget):
 
     def _home_camera(self) -> None:
         # Slightly off the cube diagonal: the exact isometric view hides
-        # struts along (1, 1, 1), which lattices are full of.
-        self.plotter.view_vector((1.0, -1.7, 0.8), viewup=(0.0, 0.0, 1.0))
-        self.plotter.reset_camera()
+        # struts along (1, 1, 1), which lattices are full of.  No render here:
+        # the caller renders once.
+        ren = self.plotter.renderer
+        ren.view_vector((1.0, -1.7, 0.8), viewup=(0.0, 0.0, 1.0), render=False)
+        ren.reset_camera(render=False)
 
     def reset_camera(self) -> None:
         self._home_camera()
@@ -403,7 +371,7 @@ class Viewport(QtWidgets.QWidget):
 
     def _frame_when_sized(self) -> None:
         if not self._closed and self._frame():
-            self.plotter.render()
+            self.request_render()
 
     # -- output -------------------------------------------------------------------------
     def save_screenshot(self, path: str | Path) -> Path:
@@ -418,17 +386,7 @@ class Viewport(QtWidgets.QWidget):
     def close_plotter(self) -> None:
         """Stop the preparation thread and release the render window (must happen before the widget goes)."""
         if not self._closed:
+            self.closing.emit()
             self._closed = True
             self._prep.shutdown()
             self.plotter.close()
-
-
-def _same(a, b) -> bool:
-    return a is not None and b is not None and a[0] is b[0] and a[1] == b[1]
-
-
-def _prepare_solid(task, solid: Solid, cell, offsets: np.ndarray):
-    """Worker thread: (PreparedCell, tiled PolyData) of `solid` at `offsets`."""
-    cell = cell if cell is not None else prepare_cell(solid.vertices, solid.faces)
-    task.check()
-    return cell, tiled_polydata(cell_for_tiling(cell, len(offsets)), offsets, check=task.check)

@@ -13,7 +13,6 @@ from pathlib import Path
 from PySide6 import QtCore
 
 from engine.graph import GraphDocument, ProjectFileError, load_project, save_project
-from engine.tiled_mesh import tiled_arrays
 
 from .dialogs import MESH_FILTERS
 
@@ -160,12 +159,20 @@ class WindowFiles:
         self._update_title()
         return True
 
-    def export_mesh(self, path: str | Path | None = None) -> bool:
-        """Write the shown solid (with the current tiling) as STL / OBJ / PLY / 3MF."""
+    def export_mesh(self, path: str | Path | None = None, *, wait: bool | None = None) -> bool:
+        """Write the shown solid (with the current tiling) as STL / OBJ / PLY / 3MF, off the
+        GUI thread with progress and cancel (`ui.export_task`).  Bad input is refused before
+        anything is written.  `wait` (default: True when `path` is given, as scripts and
+        tests do; False from the menu) processes events until the export ended and returns
+        whether the file was written; otherwise True means the export started."""
+        from .export_task import check_export
+
         solid = self.current_solid()
         if solid is None:
             self.show_error("Export mesh", "there is no solid to export yet: evaluate a graph with an Object node")
             return False
+        if wait is None:
+            wait = path is not None
         if path is None:
             stem = self.project_path.stem if self.project_path else "mesoforge"
             path = self.prompter.save_path("Export mesh", str(Path.cwd() / f"{stem}.stl"),
@@ -179,16 +186,37 @@ class WindowFiles:
             return False
         if self._refuse_shipped("Export mesh", path):
             return False
-        try:
-            from engine.geometry.mesh_io import export_mesh
-            tiles = self.viewport.tiles if solid.periodic else 1
-            vertices, faces = tiled_arrays(solid, (tiles,) * 3)
-            export_mesh(vertices, faces, path)
-        except Exception as exc:  # report any I/O or kernel failure; never crash the window
-            self.show_error("Export mesh", f"cannot export {str(path)!r}: {exc}")
+        exporter = self.mesh_export()
+        if exporter.busy:
+            self.show_error("Export mesh", f"cannot export {str(path)!r}: another export is running; "
+                                           "wait for it or press Cancel export in the status bar")
             return False
-        self.log("info", f"exported {len(faces)} triangles ({self.viewport.tiles}³ cells) to {path}")
-        return True
+        tiles = self.viewport.tiles if solid.periodic else 1
+        try:
+            tiles3, path = check_export(solid, (tiles,) * 3, path)
+        except ValueError as exc:       # a MemoryLimitError too: refused before meshing
+            self.show_error("Export mesh", str(exc))
+            return False
+        exporter.start(solid, tiles3, path)
+        return exporter.wait() if wait else True
+
+    def mesh_export(self):
+        """The window's `ui.export_task.MeshExport` (made on first use)."""
+        exporter = getattr(self, "_mesh_export", None)
+        if exporter is None:
+            from .export_task import MeshExport
+
+            exporter = MeshExport(self.statusBar(), self.log, self.show_error, parent=self)
+            # stop a running export before the window releases its widgets
+            self.viewport.closing.connect(exporter.shutdown)
+            self._mesh_export = exporter
+        return exporter
+
+    def stop_export(self) -> None:
+        """Cancel a running export and join its thread (window shutdown)."""
+        exporter = getattr(self, "_mesh_export", None)
+        if exporter is not None:
+            exporter.shutdown()
 
     # -- autosave / recovery --------------------------------------------------------------
     def autosave_now(self) -> bool:

@@ -44,7 +44,8 @@ def test_viewport_tiles_a_box_solid(qtbot):
         view.set_tiling(3)
         assert view.mesh_point_count() == 27 * len(v)
         assert view.wait_ready()                      # the tiled mesh is prepared off the GUI thread
-        bounds = view.plotter.renderer.actors["solid"].GetBounds()
+        assert view.solid_view().partial is False     # every tile drawn, at a coarser level
+        bounds = view.solid_view().bounds()
         lo, hi = block_bounds(3, 2.0 * BOX)
         assert bounds[2] == pytest.approx(lo[1]) and bounds[3] == pytest.approx(hi[1])
         assert bounds[0] == pytest.approx(lo[0] + 2.0 * 0.35, abs=0.05)       # strut radius 0.15 at x = 0.5

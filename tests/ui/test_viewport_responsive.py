@@ -1,9 +1,10 @@
 """The 3D viewport never blocks the GUI thread and frames what it shows.
 
 Counts, never wall time: GUI-thread heartbeats (a 20 ms QTimer) while the
-tiled mesh is prepared, actor replacements and full rebuilds on selection
-changes, the camera's projection of the cell box, toolpaths after another
-example opens.
+levels of detail are prepared and while the tiling is toggled, actor
+replacements, preparations and uploads (mappers) on selection and tiling
+changes, triangles drawn while the camera moves and when it stops, the
+camera's projection of the cell box, toolpaths after another example opens.
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ import numpy as np
 import pytest
 from PySide6 import QtCore
 
+import ui.scene_lod as scene_lod
 import ui.viewport as viewport_module
+import ui.viewport_solid as viewport_solid
 from ui.main_window import EXAMPLES_DIR
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
@@ -87,21 +90,28 @@ def test_selection_changes_replace_no_solid_and_rebuild_nothing(octet, qtbot):
     assert vp.scene.replaced["solid"] == before and vp.scene.full_rebuilds == 0
 
 
-def test_tiling_is_prepared_while_the_gui_thread_keeps_ticking(octet, qtbot, monkeypatch):
-    vp = octet.viewport
-    single = vp.mesh_point_count()
+def test_levels_are_prepared_while_the_gui_thread_keeps_ticking(make_window, wait_eval, qtbot, monkeypatch):
     gate = threading.Event()
-    real = viewport_module.tiled_polydata
+    real = viewport_solid.build_levels
 
-    def held(*args, **kwargs):                   # the preparation waits until the GUI has ticked
-        assert gate.wait(60), "the GUI thread never ticked while the tiled mesh was prepared"
-        return real(*args, **kwargs)
+    def held(*args, **kwargs):                   # the full cell comes at once, the coarser levels wait
+        for k, levels in enumerate(real(*args, **kwargs)):
+            if k == 1:
+                assert gate.wait(60), "the GUI thread never ticked while the levels were made"
+            yield levels
 
-    monkeypatch.setattr(viewport_module, "tiled_polydata", held)
+    monkeypatch.setattr(viewport_solid, "build_levels", held)
+    window = make_window(open_example=True)
     beat = Heartbeat()
     try:
-        octet.act_tiling.setChecked(True)        # returns at once: the mesh is prepared elsewhere
+        assert wait_eval(window, 0, timeout=180000).ok
+        vp = window.viewport
+        single = len(vp.solid.vertices)
+        qtbot.waitUntil(lambda: vp.shown_mesh_point_count() == single, timeout=60000)  # the full cell, drawn
         assert not vp.is_ready
+        window.act_tiling.setChecked(True)       # returns at once; no level fits 27 copies yet
+        view = vp.solid_view()
+        assert view.partial and vp.shown_mesh_point_count() == single   # the middle tile only
         start = beat.ticks
         qtbot.waitUntil(lambda: beat.ticks - start >= HEARTBEATS_WHILE_PREPARING, timeout=30000)
         assert not vp.is_ready                   # still preparing, and the GUI ticked N times
@@ -110,18 +120,95 @@ def test_tiling_is_prepared_while_the_gui_thread_keeps_ticking(octet, qtbot, mon
     finally:
         gate.set()
         beat.stop()
+    vp.plotter.render()
     assert vp.mesh_point_count() == 27 * single
-    assert 0 < vp.shown_mesh_point_count() <= 27 * single
-    prepared, swaps = vp.prepared, vp.scene.replaced["solid"]
-    for nid in list(octet.doc.nodes)[:4]:        # selections keep the tiled mesh
-        octet.editor.select(nid)
-        assert vp.wait_ready()
+    assert not view.partial and view.in_view == 27
+    assert 27 * single > vp.shown_mesh_point_count() > 0            # every tile, at a coarser level
+    assert view.drawn_triangles() <= scene_lod.STILL_BUDGET
+
+
+def test_tiling_and_selections_reuse_the_uploaded_levels(octet, qtbot):
+    vp = octet.viewport
+    view = vp.solid_view()
+    mappers = list(view.mappers)
+    prepared = vp.prepared
+    beat = Heartbeat()
+    try:
+        for _ in range(3):                       # toggling adds / removes tiles: nothing prepared or uploaded
+            for on in (True, False):
+                octet.act_tiling.setChecked(on)
+                assert vp.wait_ready() and vp.prepared == prepared
+                start = beat.ticks
+                qtbot.waitUntil(lambda: beat.ticks - start >= 2, timeout=30000)   # the GUI thread ticks between
+                assert len(view.actors) == (27 if on else 1)
+                assert view.drawn_triangles() <= max(scene_lod.STILL_BUDGET, len(vp.solid.faces))
+        octet.act_tiling.setChecked(True)
+        for nid in list(octet.doc.nodes)[:4]:    # selections keep the tiles
+            octet.editor.select(nid)
+            assert vp.wait_ready()
+    finally:
+        beat.stop()
     octet.editor.select(octet.shown_solid_id)
-    octet.act_tiling.setChecked(False)           # both tilings of this solid are kept: no new preparation
-    octet.act_tiling.setChecked(True)
-    assert vp.is_ready and vp.prepared == prepared
+    assert vp.wait_ready() and vp.solid_view() is view
+    assert vp.prepared == prepared and view.mappers == mappers
+    assert all(a.GetMapper() is view.mappers[view.level] for a in view.actors)
     assert vp.scene.full_rebuilds == 0
-    assert vp.scene.replaced["solid"] >= swaps
+
+
+def drag(vp, moves=4):
+    """A left-button drag on the render window through the VTK interactor (what a mouse drag does);
+    returns whether the frames during the drag were drawn as moving."""
+    iren = vp.plotter.iren.interactor
+    w, h = vp.plotter.render_window.GetSize()
+    seen = []
+    iren.SetEventInformation(w // 2, h // 2, 0, 0)
+    iren.InvokeEvent("LeftButtonPressEvent")
+    for k in range(1, moves + 1):
+        iren.SetEventInformation(w // 2 + 15 * k, h // 2 + 5 * k, 0, 0)
+        iren.InvokeEvent("MouseMoveEvent")
+        seen.append(vp.solid_view().last_moving)
+    iren.InvokeEvent("LeftButtonReleaseEvent")
+    return seen
+
+
+def test_level_of_detail_is_coarse_while_the_camera_moves_and_full_when_still(octet):
+    vp = octet.viewport
+    view = vp.solid_view()
+    full = len(vp.solid.faces)
+    vp.plotter.render()
+    assert view.drawn_triangles() == full and not view.last_moving     # a still close cell: the full mesh
+    assert vp.shown_mesh_point_count() == len(vp.solid.vertices)
+    assert all(drag(vp))                                                 # while dragging: the coarse level
+    assert view.last_moving is False                                     # the release renders it still again
+    assert view.drawn_triangles() == full                                # full geometry restored
+    frames = []
+    tag = vp.plotter.render_window.AddObserver("EndEvent", lambda *_: frames.append(view.last_moving))
+    vp.plotter.iren.interactor.InvokeEvent("MouseWheelForwardEvent")    # a wheel notch: coarse, then still
+    vp.plotter.render_window.RemoveObserver(tag)
+    assert frames and frames[-1] is False and view.drawn_triangles() == full
+    octet.act_tiling.setChecked(True)
+    assert vp.wait_ready()
+    vp.plotter.render()
+    still = view.drawn_triangles()
+    assert view.in_view == 27 and still <= scene_lod.STILL_BUDGET
+    moving = drag(vp)
+    assert all(moving)
+    vp.plotter.render_window.SetDesiredUpdateRate(vp.plotter.iren.interactor.GetDesiredUpdateRate())
+    vp.plotter.render()
+    assert view.drawn_triangles() <= scene_lod.MOVING_BUDGET < still
+    vp.plotter.render_window.SetDesiredUpdateRate(vp.plotter.iren.interactor.GetStillUpdateRate())
+    vp.plotter.render()
+    assert view.drawn_triangles() == still
+    cam = vp.plotter.camera                       # close to the middle tile: few tiles in view, finer tiles
+    cam.focal_point = tuple(0.5 * vp.cell_box())
+    cam.position = tuple(0.5 * vp.cell_box() + np.array([0.0, -0.6, 0.0]) * float(vp.cell_box().max()))
+    vp.plotter.render()
+    assert view.in_view < 27
+    assert view.drawn_triangles() / view.in_view > still / 27
+    octet.act_tiling.setChecked(False)
+    assert vp.wait_ready()
+    vp.reset_camera()
+    assert view.drawn_triangles() == full and vp.shown_mesh_point_count() == len(vp.solid.vertices)
 
 
 def test_camera_frames_the_whole_cell_on_first_view_and_after_tiling(octet):
@@ -146,3 +233,26 @@ def test_toolpaths_go_when_another_example_opens(octet, wait_eval):
     assert vp.toolpath_segment_count() == 2      # a selection keeps it
     assert octet.open_example(EXAMPLES_DIR / "bcc.json", ask=False)
     assert vp.toolpath_segment_count() == 0 and "toolpaths" not in vp.plotter.actors
+
+
+def test_an_unchanged_scene_is_not_rendered_again(octet, qtbot):
+    vp = octet.viewport
+    widget = vp.plotter
+    frames = []
+    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
+    try:
+        skips = widget.timer_skips
+        qtbot.waitUntil(lambda: widget.timer_skips >= skips + 2, timeout=30000)   # the 5/s auto-update ticked
+        for k in range(5):                      # repaints of the window (status text): the last frame is shown
+            octet.statusBar().showMessage(f"message {k}")
+            widget.repaint()
+        assert frames == [] and widget.paint_skips > 0
+        widget.camera.azimuth += 30.0           # a change nobody rendered: the auto-update draws it
+        qtbot.waitUntil(lambda: len(frames) >= 1, timeout=30000)
+        vp.plotter.render()                     # an explicit render is done once, not again by the repaint
+        count = len(frames)
+        skips = widget.paint_skips
+        qtbot.waitUntil(lambda: widget.paint_skips > skips, timeout=30000)
+        assert len(frames) == count
+    finally:
+        widget.render_window.RemoveObserver(tag)

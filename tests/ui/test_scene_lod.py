@@ -1,0 +1,103 @@
+"""Levels of detail (`ui.scene_lod`) and the tiles sharing them (`ui.solid_actors`), without a window.
+
+The choice of level is checked against the rules written out by hand; the
+decimated levels against the full mesh they come from (bounds, closedness
+of the surface as measured by its volume, unit normals); the tiles in view
+against the camera's frustum computed independently for a camera looking
+down the axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from ui.scene_lod import (MOVING_BUDGET, STILL_BUDGET, TRIANGLES_PER_PIXEL, build_levels, level_targets,
+                          pick_level, pixels_per_mm)
+
+LEVELS = [123_248, 4_444, 1_481, 40_000, 15_000]       # the octet cell's ladder (build order)
+
+
+def test_ladder_targets_what_each_view_can_afford():
+    assert level_targets(123_248) == LEVELS
+    assert level_targets(5_000) == [5_000, 1_481]              # 4 444 is not clearly coarser than 5 000
+    assert level_targets(300) == [300]                         # too small to decimate
+    targets = level_targets(2_000_000)
+    assert targets[0] == 2_000_000 and sorted(targets[1:], reverse=True) == [40_000, 15_000, 4_444, 1_481]
+
+
+def test_a_still_single_cell_is_drawn_in_full():
+    for pixels in (50, 300, 2000):
+        assert pick_level(LEVELS, 1, pixels, moving=False) == (0, True)
+
+
+def test_moving_views_keep_to_the_moving_budget():
+    i, fits = pick_level(LEVELS, 1, 500, moving=True)
+    assert fits and LEVELS[i] == 40_000 <= MOVING_BUDGET
+    i, fits = pick_level(LEVELS, 27, 170, moving=True)
+    assert fits and 27 * LEVELS[i] <= MOVING_BUDGET and LEVELS[i] == 1_481
+
+
+def test_a_still_tiled_view_gets_the_finest_level_the_budget_allows():
+    i, fits = pick_level(LEVELS, 27, 170, moving=False)
+    assert fits and LEVELS[i] == 4_444 and 27 * LEVELS[i] <= STILL_BUDGET
+    i, _ = pick_level(LEVELS, 8, 600, moving=False)             # close: 8 tiles in view get finer tiles
+    assert LEVELS[i] == 15_000
+    i, _ = pick_level(LEVELS, 27, 10, moving=False)             # far away: enough detail is little
+    assert LEVELS[i] == 1_481 >= TRIANGLES_PER_PIXEL * 10 ** 2
+
+
+def test_nothing_fits_until_a_coarse_level_exists():
+    assert pick_level([123_248], 27, 170, moving=False) == (0, False)
+    assert pick_level([123_248, 4_444], 27, 170, moving=False) == (1, True)
+
+
+def test_pixels_per_mm_of_a_perspective_and_a_parallel_camera():
+    # 90 degrees: the half height at distance d is d, so the screen shows 2 d mm
+    assert pixels_per_mm(800, 10.0, 90.0) == pytest.approx(800 / 20.0)
+    assert pixels_per_mm(800, 10.0, 30.0, parallel=True, parallel_scale=4.0) == pytest.approx(100.0)
+
+
+def test_decimated_levels_keep_the_shape():
+    sphere = pv.Sphere(radius=1.0, theta_resolution=120, phi_resolution=120).triangulate()
+    v, f = np.asarray(sphere.points), np.asarray(sphere.regular_faces)
+    levels = list(build_levels(v, f))
+    assert len(levels[0]) == 1 and [len(x) for x in levels] == list(range(1, len(levels) + 1))
+    cells = levels[-1]
+    assert len(cells[0].faces) == len(f)
+    for cell, target in zip(cells, level_targets(len(f))):
+        assert len(cell.faces) <= 1.1 * target
+        mesh = pv.PolyData.from_regular_faces(cell.vertices, cell.faces)
+        np.testing.assert_allclose(mesh.bounds, sphere.bounds, atol=0.05)
+        assert mesh.volume == pytest.approx(4.0 / 3.0 * np.pi, rel=0.05)        # still a closed ball
+        np.testing.assert_allclose(np.linalg.norm(cell.normals, axis=1), 1.0, atol=1e-5)
+
+
+def test_tiles_in_view_follow_the_frustum():
+    from ui.scene_prep import prepare_cell
+    from ui.solid_actors import SolidActors
+    from ui.view_content import tile_offsets
+
+    plotter = pv.Plotter(off_screen=True, window_size=(400, 400))
+    try:
+        box = pv.Box(bounds=(0, 1, 0, 1, 0, 1)).triangulate()
+        cell = prepare_cell(np.asarray(box.points), np.asarray(box.regular_faces))
+        view = SolidActors(plotter.renderer, pv.Property(), np.ones(3))
+        view.set_levels([cell], complete=True)
+        view.set_offsets(tile_offsets(3, 1.0))
+        cam = plotter.camera
+        cam.focal_point, cam.position, cam.up = (0.5, 0.5, 0.5), (0.5, 0.5, 20.0), (0, 1, 0)
+        plotter.render()
+        assert view.copies_in_view() == 27
+        # a narrow view (2 degrees) from z = 12 down the middle column: at the lowest tile (z = -1)
+        # it is 2 * 13 * tan(1 degree) = 0.45 mm wide, inside the column x, y in [0, 1]
+        cam.view_angle = 2.0
+        cam.position, cam.focal_point = (0.5, 0.5, 12.0), (0.5, 0.5, 0.0)
+        plotter.renderer.ResetCameraClippingRange()
+        assert view.copies_in_view() == 3
+        cam.position, cam.focal_point = (0.5, 0.5, 12.0), (0.5, 0.5, 24.0)      # looking away
+        plotter.renderer.ResetCameraClippingRange()
+        assert view.copies_in_view() == 0
+    finally:
+        plotter.close()

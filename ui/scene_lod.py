@@ -1,0 +1,109 @@
+"""Levels of detail of a solid's cell mesh, and which one a view draws.
+
+The software renderer (llvmpipe) spends about a microsecond a triangle, so
+a frame's cost is set by the triangles drawn.  A cell is drawn as copies of
+one mesh (`ui.solid_actors`), so a 3x3x3 tiling draws 27 times the cell's
+triangles; at that size a cell spans ~150 pixels and its full mesh has
+several triangles per pixel, invisible detail.  So each solid gets a ladder
+of decimated cell meshes, built once off the GUI thread (`build_levels`),
+and every frame draws the level `pick_level` chooses from the cell's size
+on screen, the number of copies and whether the camera is moving:
+
+* enough detail: the coarsest level with at least `TRIANGLES_PER_PIXEL`
+  triangles per pixel of the cell's projected square; with the camera
+  still and a single cell in view, always the full mesh;
+* within budget: the copies in view together draw at most `STILL_BUDGET`
+  triangles (or one full cell, if that is more; a single cell in view is
+  exempt: its full mesh is always allowed) or, while the camera moves,
+  `MOVING_BUDGET`.
+
+Plain numpy / pyvista, no Qt and no render window.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterator, Sequence
+
+import numpy as np
+import pyvista as pv
+
+from .scene_prep import PreparedCell, prepare_cell
+
+STILL_BUDGET = 120_000        # triangles a still tiled view draws at most (~100 ms a frame on llvmpipe)
+MOVING_BUDGET = 40_000        # triangles drawn while the camera moves (>= 10 frames/s)
+TRIANGLES_PER_PIXEL = 1.0     # detail wanted: triangles per pixel of the cell's projected square
+MIN_LEVEL_TRIANGLES = 400     # no level coarser than this
+LEVEL_GAP = 0.8               # a level is only made if it has fewer than this fraction of the finer one's triangles
+TILE_COPIES = 27              # the tiled view (3x3x3) the ladder is made for
+CLOSE_COPIES = 8              # tiles in view when the camera is close to a tiled block
+
+
+def level_targets(full: int, copies: int = TILE_COPIES) -> list[int]:
+    """Triangle counts of the ladder for a cell of `full` triangles, finest first:
+    the full mesh, then what a still tiled view, a moving tiled view and a moving
+    single cell can afford (each only if clearly coarser than the previous)."""
+    wanted = [max(MIN_LEVEL_TRIANGLES, int(t)) for t in    # build order: the tiled view's first
+              (STILL_BUDGET // copies, MOVING_BUDGET // copies, MOVING_BUDGET, STILL_BUDGET // CLOSE_COPIES)]
+    kept = [int(full)]
+    for t in sorted(set(wanted), reverse=True):
+        if t < LEVEL_GAP * kept[-1]:
+            kept.append(t)
+    return [int(full)] + [t for t in dict.fromkeys(wanted) if t in kept[1:]]
+
+
+def decimated(cell: PreparedCell, target: int) -> PreparedCell:
+    """`cell` reduced to about `target` triangles by quadric decimation, with fresh normals."""
+    m = len(cell.faces)
+    if target >= m:
+        return cell
+    mesh = pv.PolyData.from_regular_faces(cell.vertices, cell.faces)
+    coarse = mesh.decimate(1.0 - target / float(m), boundary_constraints=True)
+    faces = np.asarray(coarse.regular_faces, dtype=np.int64)
+    return prepare_cell(np.asarray(coarse.points), faces) if len(faces) else cell
+
+
+def build_levels(vertices: np.ndarray, faces: np.ndarray, check: Callable[[], None] | None = None
+                 ) -> Iterator[tuple[PreparedCell, ...]]:
+    """Yield the growing ladder (a tuple of PreparedCell, in build order): first the
+    full cell, then one more decimated level each time.  Each level is decimated
+    from the coarsest finer level already made.  `check` runs between levels."""
+    full = prepare_cell(vertices, faces)
+    levels = [full]
+    yield tuple(levels)
+    for target in level_targets(len(full.faces))[1:]:
+        if check is not None:
+            check()
+        finer = [c for c in levels if len(c.faces) > target]
+        source = min(finer, key=lambda c: len(c.faces)) if finer else full
+        levels.append(decimated(source, target))
+        yield tuple(levels)
+
+
+def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: bool) -> tuple[int, bool]:
+    """(index into `counts`, fits): the level to draw.
+
+    counts : triangles of each available level (any order)
+    copies : cells in view (of 1 or 27 drawn)
+    cell_pixels : the cell's longest edge on screen, pixels
+    fits : False if even the coarsest level is over the budget (the caller may then
+        draw fewer copies until a coarser level is made)."""
+    order = sorted(range(len(counts)), key=lambda i: counts[i])      # coarse -> fine
+    wanted = TRIANGLES_PER_PIXEL * max(cell_pixels, 1.0) ** 2
+    enough = next((i for i in order if counts[i] >= wanted), order[-1])
+    if copies == 1 and not moving:
+        enough = order[-1]                   # one cell in view, camera still: the full mesh
+    budget = MOVING_BUDGET if moving else (math.inf if copies == 1 else max(STILL_BUDGET, max(counts)))
+    allowed = [i for i in order if copies * counts[i] <= budget and counts[i] <= counts[enough]]
+    if allowed:
+        return allowed[-1], True
+    return order[0], False
+
+
+def pixels_per_mm(height_px: int, distance: float, view_angle_deg: float,
+                  parallel: bool = False, parallel_scale: float = 1.0) -> float:
+    """Screen pixels per mm at `distance` from a camera with vertical view angle
+    `view_angle_deg` (or a parallel projection of half-height `parallel_scale` mm)."""
+    if parallel:
+        return height_px / max(2.0 * parallel_scale, 1e-12)
+    return height_px / max(2.0 * distance * math.tan(math.radians(view_angle_deg) / 2.0), 1e-12)
