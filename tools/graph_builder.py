@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from engine.graph import AddNode, Connect, GraphDocument, UndoStack, save_project
-from engine.graph.layout import layered_positions
+from engine.graph.layout import fit_columns, layered_positions
 
 from example_catalogue import catalogue_meta
 
@@ -21,6 +21,7 @@ OBJECT_RESOLUTION = 96          # Object node grid, as in the paper's examples
 MATERIAL = {"E": 1.0, "nu": 0.45, "rho": 1.0}   # paper section 8.2
 COLUMN_WIDTH = 250.0
 ROW_HEIGHT = 110.0
+EDITOR_VIEW = (420.0, 640.0)   # px: the node graph dock of the default layout on a 1366 x 768 screen
 
 # Output / input port names of the node types the examples use.
 _OUT = {"Vertex": "point", "EdgeChain": "chain", "Line": "skeleton", "Surface": "skeleton",
@@ -131,10 +132,14 @@ class GraphBuilder:
     # -- replay -----------------------------------------------------------
     def positions(self) -> dict[str, tuple[float, float]]:
         """Readable columns (engine.graph.layout.layered_positions): a node's
-        column is its depth, rows ordered to reduce edge crossings."""
+        column is its depth, rows ordered to reduce edge crossings, the columns
+        wrapped into bands so the graph reads largest in the default node editor
+        (`EDITOR_VIEW`, engine.graph.layout.fit_columns)."""
         edges = [(src, node_id) for node_id, _, _, inputs in self._nodes for src in inputs]
-        return layered_positions([n[0] for n in self._nodes], edges,
-                                 column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
+        ids = [n[0] for n in self._nodes]
+        bands = fit_columns(ids, edges, EDITOR_VIEW, column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
+        return layered_positions(ids, edges, column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT,
+                                 max_columns=bands)
 
     def document(self) -> GraphDocument:
         doc = GraphDocument(seed=0)

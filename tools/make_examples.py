@@ -51,10 +51,10 @@ if str(ROOT) not in sys.path:
 from engine.graph import AddNode, Connect, GraphDocument, UndoStack  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from graph_builder import (COLUMN_WIDTH, ROW_HEIGHT, GraphBuilder as _Builder, r6, vec6,  # noqa: E402
-                           write_documents)
+from graph_builder import (COLUMN_WIDTH, EDITOR_VIEW, ROW_HEIGHT, GraphBuilder as _Builder,  # noqa: E402
+                           r6, vec6, write_documents)
 
-from engine.graph.layout import layered_positions  # noqa: E402
+from engine.graph.layout import fit_columns, layered_positions  # noqa: E402
 
 EXAMPLES_DIR = ROOT / "resources" / "examples"
 
@@ -510,6 +510,12 @@ def write_property_examples(out_dir: str | Path = EXAMPLES_DIR, names=None) -> d
 # each Grow node followed by Tiling Properties, so the Virtual Growth dock
 # shows the tiling, its block mix and its stiffness when the example opens.
 
+def _arranged(ids: list[str], edges: list[tuple[str, str]]) -> dict[str, tuple[float, float]]:
+    """Positions in readable columns, wrapped into bands that fit the default node editor."""
+    bands = fit_columns(ids, edges, EDITOR_VIEW, column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
+    return layered_positions(ids, edges, column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT, max_columns=bands)
+
+
 def _growth_document(name: str, meta: dict, tileset: str, grow: dict, *, three_d: bool) -> GraphDocument:
     doc = GraphDocument(seed=0)
     doc.meta = {"example": name, "source": "Liu, Sun & Daraio 2022 (virtual growth)",
@@ -519,8 +525,7 @@ def _growth_document(name: str, meta: dict, tileset: str, grow: dict, *, three_d
              (show[0], show[1], {}), ("properties", "TilingProperties", {})]
     edges = [("tileset", "tileset", "grow", "tileset"), ("grow", "tiling", show[0], "tiling"),
              ("grow", "tiling", "properties", "tiling")]
-    pos = layered_positions([n[0] for n in nodes], [(e[0], e[2]) for e in edges],
-                            column_width=COLUMN_WIDTH, row_height=ROW_HEIGHT)
+    pos = _arranged([n[0] for n in nodes], [(e[0], e[2]) for e in edges])
     stack = UndoStack(doc)
     for node_id, type_name, params in nodes:
         stack.push(AddNode(type_name, params, pos[node_id], node_id=node_id))
@@ -598,12 +603,12 @@ def phasor_slab() -> GraphDocument:
                   "radius": 15.0},
             "Gamma": 0.0}
     stack = UndoStack(doc)
+    pos = _arranged(["fields", "noise", "slice"], [("fields", "noise"), ("noise", "slice")])
     stack.push(AddNode("PhasorFields", {"lo": [-15.0, -15.0, 0.0], "hi": [15.0, 15.0, 6.0],
                                         "resolution": 64, "spec": json.dumps(spec)},
-                       (0.0, 0.0), node_id="fields"))
-    stack.push(AddNode("PhasorNoise", {}, (COLUMN_WIDTH, 0.0), node_id="noise"))
-    stack.push(AddNode("PhasorSlice", {"position": 3.0, "pixel": 0.1}, (2 * COLUMN_WIDTH, 0.0),
-                       node_id="slice"))
+                       pos["fields"], node_id="fields"))
+    stack.push(AddNode("PhasorNoise", {}, pos["noise"], node_id="noise"))
+    stack.push(AddNode("PhasorSlice", {"position": 3.0, "pixel": 0.1}, pos["slice"], node_id="slice"))
     stack.push(Connect("fields", "fields", "noise", "fields"))
     stack.push(Connect("noise", "infill", "slice", "infill"))
     arc = [[_r(8.0 * math.cos(math.radians(a))), _r(8.0 * math.sin(math.radians(a)))]
@@ -651,13 +656,13 @@ def rd_cantilever() -> GraphDocument:
                                "painted solid region keeps the load point full. The compiled lattice is "
                                "the union of the two stripe families at iso 0.7 (paper Fig. 11)."}
     stack = UndoStack(doc)
+    pos = _arranged(["topopt", "fields", "grow", "compile"],
+                    [("topopt", "fields"), ("fields", "grow"), ("grow", "compile")])
     stack.push(AddNode("TopOpt", {"preset": "cantilever", "resolution": [64, 32], "max_iter": 60},
-                       (0.0, 0.0), node_id="topopt"))
-    stack.push(AddNode("RDFields", {"regularise": True, "coherence": True}, (COLUMN_WIDTH, 0.0),
-                       node_id="fields"))
-    stack.push(AddNode("RDGrow", {"resolution": [640, 320], "max_steps": 20000}, (2 * COLUMN_WIDTH, 0.0),
-                       node_id="grow"))
-    stack.push(AddNode("RDCompile", {"iso": 0.7}, (3 * COLUMN_WIDTH, 0.0), node_id="compile"))
+                       pos["topopt"], node_id="topopt"))
+    stack.push(AddNode("RDFields", {"regularise": True, "coherence": True}, pos["fields"], node_id="fields"))
+    stack.push(AddNode("RDGrow", {"resolution": [640, 320], "max_steps": 20000}, pos["grow"], node_id="grow"))
+    stack.push(AddNode("RDCompile", {"iso": 0.7}, pos["compile"], node_id="compile"))
     stack.push(Connect("topopt", "design", "fields", "design"))
     stack.push(Connect("fields", "rdfields", "grow", "rdfields"))
     stack.push(Connect("grow", "structures", "compile", "structures"))

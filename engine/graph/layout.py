@@ -6,13 +6,19 @@ edges spanning several columns get virtual waypoints, then barycentre sweeps
 (down and up) and adjacent swaps refine the order; the best order found is kept,
 never one with more crossings than the input order. Pure and deterministic: the
 same ids and edges in the same order give the same positions.
+
+A long chain of columns is hard to read in a narrow editor: with
+``max_columns`` the columns wrap into bands stacked top to bottom, read like
+lines of text (the edges from a band's last columns run down to the next
+band's first ones). `fit_columns` picks the band width at which a view of a
+given size shows the whole graph largest.
 """
 
 from __future__ import annotations
 
 from itertools import combinations
 
-__all__ = ["layered_positions", "layer_depths"]
+__all__ = ["layered_positions", "layer_depths", "fit_columns"]
 
 _SWEEPS = 12
 _GEOMETRIC_CHECK_MAX_EDGES = 150  # above, the sweeps' own count decides (pairwise check is O(E^2))
@@ -20,21 +26,18 @@ _GEOMETRIC_CHECK_MAX_EDGES = 150  # above, the sweeps' own count decides (pairwi
 
 def layered_positions(node_ids: list[str], edges: list[tuple[str, str]], *,
                       column_width: float = 240.0,
-                      row_height: float = 110.0) -> dict[str, tuple[float, float]]:
+                      row_height: float = 110.0,
+                      max_columns: int | None = None,
+                      band_gap: float | None = None) -> dict[str, tuple[float, float]]:
     """``{node id: (x, y)}``: column ``depth * column_width``, row ``k * row_height``
     with each column centred on the tallest one. ``edges`` are ``(source, target)``;
     repeated edges and self-loops are ignored; in a cycle the edge closing it (in
-    input order) is ignored for the depths. Raises ValueError for a duplicate node
-    id, an edge naming an unknown node or a non-positive spacing."""
-    if not column_width > 0 or not row_height > 0:
-        raise ValueError(f"column_width and row_height must be > 0 "
-                         f"(got {column_width!r}, {row_height!r})")
-    ids = list(node_ids)
-    index = {nid: k for k, nid in enumerate(ids)}
-    if len(index) != len(ids):
-        dup = next(nid for k, nid in enumerate(ids) if index[nid] != k)
-        raise ValueError(f"node id {dup!r} appears more than once")
-    pairs = _clean_edges(index, edges)
+    input order) is ignored for the depths. With ``max_columns`` (>= 1) column
+    ``depth`` goes to band ``depth // max_columns`` at x ``(depth % max_columns) *
+    column_width``; each band starts ``band_gap`` (default ``row_height``) below the
+    one above it. Raises ValueError for a duplicate node id, an edge naming an
+    unknown node, a non-positive spacing or ``max_columns`` < 1."""
+    ids, pairs = _checked(node_ids, edges, column_width, row_height, max_columns, band_gap)
     depth = layer_depths(ids, pairs)
     forward = [(s, t) for s, t in pairs if depth[s] < depth[t]]
     layers = _initial_layers(ids, depth)
@@ -46,7 +49,53 @@ def layered_positions(node_ids: list[str], edges: list[tuple[str, str]], *,
         chosen = candidates[-min(scored)[1]]
     else:
         chosen = candidates[1]
-    return _place(chosen, column_width, row_height)
+    return _place(chosen, column_width, row_height, max_columns, band_gap)
+
+
+def fit_columns(node_ids: list[str], edges: list[tuple[str, str]], view: tuple[float, float], *,
+                column_width: float = 240.0, row_height: float = 110.0,
+                node_size: tuple[float, float] = (180.0, 80.0), band_gap: float | None = None) -> int:
+    """The ``max_columns`` at which the whole layout, fitted into a ``view`` of
+    (width, height) pixels and never shown larger than 1:1, is drawn largest (ties:
+    the fewest bands, so a graph that fits at 1:1 stays one row).
+    ``node_size`` is the (width, height) of the largest node."""
+    ids, pairs = _checked(node_ids, edges, column_width, row_height, None, band_gap)
+    depth = layer_depths(ids, pairs)
+    counts = [0] * (max(depth.values(), default=-1) + 1)
+    for d in depth.values():
+        counts[d] += 1
+    if not counts:
+        return 1
+    w, h = (float(v) for v in view)
+    if not (w > 0 and h > 0):
+        raise ValueError(f"view must be a positive (width, height), got {view!r}")
+    gap = row_height if band_gap is None else band_gap
+    best, best_scale = len(counts), -1.0
+    for k in range(len(counts), 0, -1):
+        bands = [counts[b:b + k] for b in range(0, len(counts), k)]
+        width = (min(k, len(counts)) - 1) * column_width + node_size[0]
+        height = sum((max(b) - 1) * row_height + node_size[1] for b in bands) + gap * (len(bands) - 1)
+        scale = min(1.0, w / width, h / height)       # a view never zooms in past 1:1
+        if scale > best_scale * (1.0 + 1e-9):
+            best, best_scale = k, scale
+    return best
+
+
+def _checked(node_ids, edges, column_width, row_height, max_columns, band_gap):
+    if not column_width > 0 or not row_height > 0:
+        raise ValueError(f"column_width and row_height must be > 0 "
+                         f"(got {column_width!r}, {row_height!r})")
+    if max_columns is not None and (isinstance(max_columns, bool) or not isinstance(max_columns, int)
+                                    or max_columns < 1):
+        raise ValueError(f"max_columns must be an integer >= 1 or None (got {max_columns!r})")
+    if band_gap is not None and not band_gap >= 0:
+        raise ValueError(f"band_gap must be >= 0 (got {band_gap!r})")
+    ids = list(node_ids)
+    index = {nid: k for k, nid in enumerate(ids)}
+    if len(index) != len(ids):
+        dup = next(nid for k, nid in enumerate(ids) if index[nid] != k)
+        raise ValueError(f"node id {dup!r} appears more than once")
+    return ids, _clean_edges(index, edges)
 
 
 def layer_depths(node_ids: list[str], edges: list[tuple[str, str]]) -> dict[str, int]:
@@ -233,14 +282,20 @@ class _Sweeper:
                 break
 
 
-def _place(layers: list[list[str]], column_width: float,
-           row_height: float) -> dict[str, tuple[float, float]]:
-    tallest = max((len(layer) for layer in layers), default=0)
+def _place(layers: list[list[str]], column_width: float, row_height: float,
+           max_columns: int | None = None, band_gap: float | None = None) -> dict[str, tuple[float, float]]:
+    per = max_columns or max(len(layers), 1)
+    gap = row_height if band_gap is None else band_gap
     out: dict[str, tuple[float, float]] = {}
-    for c, layer in enumerate(layers):
-        top = (tallest - len(layer)) * row_height / 2.0
-        for r, nid in enumerate(layer):
-            out[nid] = (c * column_width, top + r * row_height)
+    y0 = 0.0
+    for b in range(0, len(layers), per):
+        band = layers[b:b + per]
+        tallest = max(len(layer) for layer in band)
+        for c, layer in enumerate(band):
+            top = y0 + (tallest - len(layer)) * row_height / 2.0
+            for r, nid in enumerate(layer):
+                out[nid] = (c * column_width, top + r * row_height)
+        y0 += tallest * row_height + gap
     return out
 
 

@@ -24,7 +24,7 @@ import trimesh
 
 from engine.graph import load_project
 
-from .example_files import EXAMPLES_DIR, evaluate_at, load_tool
+from .example_files import EXAMPLES_DIR, check_reading_layout, evaluate_at, load_tool
 
 TEST_RESOLUTION = 48
 
@@ -112,9 +112,7 @@ def test_graph_shape(path):
         f"{path.stem}: {len(doc.nodes)} nodes, paper {reference}"
     paper = doc.meta.get("paper_node_count")
     assert paper is None or paper == reference
-    # the editor layout runs left to right: every edge goes to a later column
-    for e in doc.edges:
-        assert doc.node(e.src).position[0] < doc.node(e.dst).position[0]
+    check_reading_layout(doc, path.stem)
 
 
 def test_evaluates_to_one_voxel_model(example):
@@ -184,17 +182,17 @@ def test_every_family_has_an_example():
 
 @pytest.mark.parametrize("path", ALL_FILES, ids=[p.stem for p in ALL_FILES])
 def test_layout_is_readable_columns(path):
-    """Every edge runs left to right, no two nodes share a place, and a column
-    holds nodes of one depth (engine.graph.layout)."""
+    """The layout of engine.graph.layout, wrapped into bands that fit the default node
+    editor (tools/graph_builder.EDITOR_VIEW) at least as well as one long row."""
+    from engine.graph.layout import fit_columns
+
     doc = load_project(path)
-    places = [tuple(n.position) for n in doc.nodes.values()]
-    assert len(set(places)) == len(places), f"{path.stem}: nodes on top of each other"
-    for e in doc.edges:
-        assert doc.node(e.src).position[0] < doc.node(e.dst).position[0], f"{path.stem}: {e.src} -> {e.dst}"
-    rows_per_column: dict[float, set] = {}
-    for x, y in places:
-        rows_per_column.setdefault(x, set()).add(y)
-    assert all(len(ys) == sum(1 for p in places if p[0] == x) for x, ys in rows_per_column.items())
+    check_reading_layout(doc, path.stem)
+    builder = load_tool("make_examples")            # its graph_builder constants
+    edges = [(e.src, e.dst) for e in doc.edges]
+    xs = {n.position[0] for n in doc.nodes.values()}
+    assert len(xs) == fit_columns(list(doc.nodes), edges, builder.EDITOR_VIEW,
+                                  column_width=builder.COLUMN_WIDTH, row_height=builder.ROW_HEIGHT)
 
 
 # ----------------------------------------------------------------- property and growth examples

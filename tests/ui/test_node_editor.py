@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from engine.graph import AddNode, Connect, Edge, RemoveNode, document_to_dict
+from engine.graph.layout import layer_depths
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
@@ -142,10 +143,15 @@ def test_arrange_nodes_is_one_undo_step(window, strut_graph):
     assert window.editor.arrange_nodes()
     after = {nid: n.position for nid, n in window.doc.nodes.items()}
     assert after[ids["v1"]][0] == after[ids["v2"]][0] == 0.0       # sources share the first column
-    xs = [after[ids[k]][0] for k in ("v1", "e", "l", "obj", "vox")]
-    assert xs == sorted(set(xs))                                   # one column per depth, left to right
+    # columns by depth, wrapped into bands of k columns that fit the editor: read like text
+    depth = layer_depths(list(after), [(e.src, e.dst) for e in window.doc.edges])
+    xs = sorted({p[0] for p in after.values()})
+    k = len(xs)
+    assert 1 <= k <= max(depth.values()) + 1
+    for nid, (x, _) in after.items():
+        assert xs.index(x) == depth[nid] % k
     for e in window.doc.edges:
-        assert after[e.src][0] < after[e.dst][0]
+        assert (depth[e.src] // k, after[e.src][0]) < (depth[e.dst] // k, after[e.dst][0])
     rects = [window.editor.scene_node(n).view.sceneBoundingRect() for n in after]
     assert not any(a.intersects(b) for i, a in enumerate(rects) for b in rects[i + 1:])
     assert window.editor.scene_node(ids["obj"]).pos() == list(after[ids["obj"]])

@@ -7,7 +7,7 @@ from itertools import combinations, permutations, product
 import numpy as np
 import pytest
 
-from engine.graph.layout import layer_depths, layered_positions
+from engine.graph.layout import fit_columns, layer_depths, layered_positions
 
 CW, RH = 240.0, 110.0
 
@@ -163,3 +163,75 @@ def test_refusals_name_the_problem():
         layered_positions(["a", "a"], [])
     with pytest.raises(ValueError, match="> 0"):
         layered_positions(["a"], [], column_width=0)
+
+
+# -- bands: long chains of columns wrapped for a narrow editor ----------------------------------
+
+def _chain(n):
+    ids = [f"n{k}" for k in range(n)]
+    return ids, list(zip(ids, ids[1:]))
+
+
+def _branchy(seed, n=24):
+    rng = np.random.default_rng(seed)
+    ids = [f"v{k}" for k in range(n)]
+    edges = [(ids[int(rng.integers(0, k))], ids[k]) for k in range(1, n)]
+    edges += [(ids[a], ids[b]) for a, b in rng.integers(0, n, (8, 2)) if a < b]
+    return ids, edges
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 5])
+def test_bands_keep_reading_order_and_never_overlap(k):
+    for ids, edges in (_chain(13), _branchy(3), _branchy(8)):
+        pos = layered_positions(ids, edges, column_width=200.0, row_height=100.0, max_columns=k)
+        depth = layer_depths(ids, edges)
+        band = {n: depth[n] // k for n in ids}
+        assert {round(pos[n][0] / 200.0) for n in ids} <= set(range(k))
+        for n in ids:
+            assert pos[n][0] == pytest.approx((depth[n] % k) * 200.0)
+        # every band lies wholly below the one before it (a row of nodes apart)
+        for b in range(max(band.values())):
+            low = max(pos[n][1] for n in ids if band[n] == b)
+            high = min(pos[n][1] for n in ids if band[n] == b + 1)
+            assert high >= low + 200.0 - 1e-9
+        # edges read forward: to a later band, or to a later column of the same band
+        for s, t in edges:
+            if depth[s] < depth[t]:
+                assert (band[s], pos[s][0]) < (band[t], pos[t][0])
+        assert len({pos[n] for n in ids}) == len(ids)
+
+
+def _drawn_scale(pos, view, node_size):
+    xs = [p[0] for p in pos.values()]
+    ys = [p[1] for p in pos.values()]
+    width = max(xs) - min(xs) + node_size[0]
+    height = max(ys) - min(ys) + node_size[1]
+    return min(1.0, view[0] / width, view[1] / height)
+
+
+@pytest.mark.parametrize("view", [(420.0, 640.0), (360.0, 900.0), (1800.0, 300.0), (800.0, 800.0)])
+def test_fit_columns_picks_the_band_width_drawn_largest(view):
+    """Reference: lay the graph out at every band width and measure its drawn size."""
+    node = (180.0, 80.0)
+    for ids, edges in (_chain(12), _branchy(5), _branchy(11, 30)):
+        chosen = fit_columns(ids, edges, view, column_width=240.0, row_height=110.0, node_size=node)
+        scales = {k: _drawn_scale(layered_positions(ids, edges, column_width=240.0, row_height=110.0,
+                                                    max_columns=k), view, node)
+                  for k in range(1, max(layer_depths(ids, edges).values()) + 2)}
+        assert scales[chosen] == pytest.approx(max(scales.values()))
+        assert all(k <= chosen for k, v in scales.items() if v == pytest.approx(scales[chosen]))
+    ids, edges = _chain(12)
+    assert fit_columns(ids, edges, (4000.0, 300.0)) == 12               # wide: one row
+    assert fit_columns(ids, edges, (420.0, 640.0)) <= 3                 # a narrow dock: wrapped
+    assert fit_columns(*_chain(2), (600.0, 400.0)) == 2                 # fits at 1:1: one row
+
+
+def test_band_refusals():
+    ids, edges = _chain(3)
+    for bad in (0, -2, 1.5, True):
+        with pytest.raises(ValueError, match="max_columns"):
+            layered_positions(ids, edges, max_columns=bad)
+    with pytest.raises(ValueError, match="band_gap"):
+        layered_positions(ids, edges, max_columns=2, band_gap=-1.0)
+    with pytest.raises(ValueError, match="view"):
+        fit_columns(ids, edges, (0.0, 100.0))
