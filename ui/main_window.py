@@ -28,6 +28,7 @@ from engine.geometry.values import Solid
 
 from .dialogs import Prompter
 from .eval_worker import EvalWorker
+from .view_content import empty_hint
 from .viewport import pick_display_nodes, pick_stiffness_node, skeleton_of, solid_of, stiffness_of
 from .window_docks import WindowDocks
 from .window_evaluation import WindowEvaluation
@@ -179,9 +180,11 @@ class MainWindow(WindowDocks, WindowLayout, WindowMenus, WindowEvaluation, Windo
         self.phasor_panel.set_context(self.doc, outputs, sel)
         self.rd_panel.set_context(self.doc, outputs, sel)
         self.viewport.drop_overlays(self._owns_overlay)
+        errors = self.last_report.errors if self.last_report is not None else None
         self.viewport.show_result(solid, skeleton, "\n".join(caption),
                                   skeleton_emphasis=bool(sel and sel == skel_id), stiffness=stiffness,
-                                  sphere_caption=sphere_caption)
+                                  sphere_caption=sphere_caption,
+                                  empty_hint=empty_hint(self.doc, errors, bool(outputs)))
 
     def _overlay_owner(self):
         """Owner of a new viewport overlay (the Phasor dock's toolpaths): this document and

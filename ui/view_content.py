@@ -163,3 +163,35 @@ def stiffness_polydata(C: np.ndarray) -> pv.PolyData:
     if np.shape(C) == (3, 3):
         return material_polar_polydata(C)
     return material_sphere_polydata(C, subdivisions=SPHERE_SUBDIVISIONS)
+
+
+# -- when there is nothing to draw -----------------------------------------------------
+EMPTY_GRAPH_HINT = ("nothing to show yet: right-click or press Tab in the node graph to add a node, "
+                    "or open an example (File › Example Gallery…)")
+NOT_EVALUATED_HINT = "nothing to show yet: the graph has no solid or skeleton node evaluated (F5 evaluates)"
+DOCK_OF_TYPE = {
+    "TileSet": "Virtual Growth", "Grow": "Virtual Growth", "TilingImage": "Virtual Growth",
+    "TilingProperties": "Virtual Growth",
+    "PhasorFields": "Phasor Infill", "PhasorNoise": "Phasor Infill", "PhasorSlice": "Phasor Infill",
+    "PhasorPreview": "Phasor Infill", "MeshImport": "Phasor Infill",
+    "TopOpt": "Reaction Diffusion", "RDFields": "Reaction Diffusion", "RDGrow": "Reaction Diffusion",
+    "RDCompile": "Reaction Diffusion",
+}
+"""The dock that shows a node type's 2D results (slices, tilings, fields)."""
+
+
+def empty_hint(doc: GraphDocument, errors: dict[str, str] | None, has_outputs: bool) -> str:
+    """What the viewport says when it has nothing to draw: why, and where to look.
+
+    errors : {node id: message} of the latest evaluation (None before any)."""
+    if not doc.nodes:
+        return EMPTY_GRAPH_HINT
+    if errors:
+        failed = sorted(errors)
+        more = f" (and {len(failed) - 1} more)" if len(failed) > 1 else ""
+        return (f"nothing to show: node {failed[0]!r}{more} failed; hover it in the node graph "
+                f"or see the Log for why")
+    docks = sorted({DOCK_OF_TYPE[n.type_name] for n in doc.nodes.values() if n.type_name in DOCK_OF_TYPE})
+    if docks and has_outputs:
+        return f"this graph's results are 2D: see the {' and '.join(docks)} dock{'s' if len(docks) > 1 else ''}"
+    return NOT_EVALUATED_HINT

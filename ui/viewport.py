@@ -76,6 +76,7 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
         self.skeleton: Skeleton | None = None
         self.stiffness: Stiffness | None = None
         self.caption = ""
+        self.empty_hint = HINT
         self.sphere_caption = ""
         self.skeleton_emphasis = False
         self.toolpaths: pv.PolyData | None = None
@@ -102,10 +103,13 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
     # -- state --------------------------------------------------------------------
     def show_result(self, solid: Solid | None, skeleton: Skeleton | None, caption: str = "",
                     *, skeleton_emphasis: bool = False, stiffness: Stiffness | None = None,
-                    sphere_caption: str = "") -> None:
+                    sphere_caption: str = "", empty_hint: str | None = None) -> None:
         """Display `solid`, `skeleton` and the material sphere of `stiffness` (any may be None);
-        `sphere_caption` joins the caption while the sphere is drawn.  Only changed actors
-        are replaced; a new solid mesh is prepared off the GUI thread."""
+        `sphere_caption` joins the caption while the sphere is drawn; `empty_hint` (when given)
+        is what it says while there is nothing to draw.  Only changed actors are replaced; a
+        new solid mesh is prepared off the GUI thread."""
+        if empty_hint is not None:
+            self.empty_hint = empty_hint
         self.solid, self.skeleton, self.caption = solid, skeleton, caption
         self.skeleton_emphasis = skeleton_emphasis
         self.stiffness, self.sphere_caption = stiffness, sphere_caption
@@ -231,7 +235,7 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
         tiles = self.tiles if self.solid is None or self.solid.periodic else 1
         changed = self._sync_solid(tiles)
         changed |= self._sync_skeleton()
-        changed |= self._sync_boxes(box)
+        changed |= self._sync_boxes(box, shown=self.has_content)
         changed |= self._sync_sphere(box)
         if self.toolpaths is None:
             changed |= self.scene.drop("toolpaths")
@@ -242,7 +246,7 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
         changed |= self._put_text("caption", "\n".join(t for t in (self.caption, sphere_line) if t), "upper_left",
                                   "white")
         empty = self.solid is None and self.skeleton is None and self.toolpaths is None
-        changed |= self._put_text("hint", HINT if empty else "", "lower_left", "#9aa0a6")
+        changed |= self._put_text("hint", self.empty_hint if empty else "", "lower_left", "#9aa0a6")
         return changed
 
     def _put_text(self, name: str, text: str, position: str, colour: str) -> bool:
@@ -274,7 +278,14 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
                            None if m is None else add(m, name=n, reset_camera=False, **s))
         return True
 
-    def _sync_boxes(self, box: np.ndarray) -> bool:
+    @property
+    def has_content(self) -> bool:
+        """Anything to draw in the cell's frame (an empty graph draws no empty box)."""
+        return any(v is not None for v in (self.solid, self.skeleton, self.toolpaths, self.stiffness))
+
+    def _sync_boxes(self, box: np.ndarray, shown: bool = True) -> bool:
+        if not shown:
+            return self.scene.drop("cell_box") | self.scene.drop("tiling_box")
         bx, by, bz = (float(v) for v in box)
         changed = self.scene.put("cell_box", (bx, by, bz), lambda: self.plotter.add_mesh(
             pv.Box(bounds=(0, bx, 0, by, 0, bz)), style="wireframe", color=BOX_COLOUR, line_width=1.5,
