@@ -93,10 +93,21 @@ def study_argv(tileset: str, *, n: int, size: str, groups=None, sweep: int | Non
     parse_size(size, ts.ndim)
     if (groups is None) == (sweep is None):
         raise ValueError("give either hint groups or a sweep size, not both")
-    for name, v, lo in (("--n", n, 1), ("--seed", seed, 0), ("--workers", workers, 1),
-                        ("--resolution", resolution or 0, 0)):
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise ValueError(f"{name} {v!r}: expected an integer >= {lo}")
+    from .study_params import SAMPLES, SEED, WORKERS, check_resolution, expected, resolution_param
+
+    for flag, param, v in (("--n", SAMPLES, n), ("--seed", SEED, seed), ("--workers", WORKERS, workers),
+                           ("--resolution", resolution_param(), resolution or 0)):
+        try:                                    # the rules of the dock's fields and the CLI's flags
+            if isinstance(v, bool) or not isinstance(v, int):
+                raise ParamError(param.name, v, "an integer")
+            param.coerce(v)
+        except ParamError:
+            raise ValueError(f"{flag} {v!r}: expected {expected(param)}") from None
+        if flag == "--resolution":
+            try:
+                check_resolution(v)
+            except ValueError as exc:
+                raise ValueError(f"{flag} {v!r}: {exc}") from None
     void_param = node_type("TilingProperties").param("void")
     try:
         void_param.coerce(void)

@@ -197,6 +197,9 @@ def test_study_argv_is_what_the_parser_reads(tmp_path):
     (dict(sweep=4, min_distance=2.0), "--sweep 4 --min-distance 2.0"),
     (dict(groups=["T=1"], size="4x"), "--size '4x'"),
     (dict(groups=["T=1"], n=0), "--n 0"),
+    (dict(groups=["T=1"], seed=2**64), "--seed 18446744073709551616: expected an integer in [0, 18446744073709551615]"),
+    (dict(groups=["T=1"], resolution=1), "--resolution 1: expected 0 (the default"),
+    (dict(groups=["T=1"], workers=0), "--workers 0: expected"),
     (dict(groups=["T=1"], out="x.txt"), "--out 'x.txt'"),
     (dict(groups=["T=1"], void="air"), "--void 'air'"),
 ])
