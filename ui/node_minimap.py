@@ -1,6 +1,7 @@
 """The node editor's overlays: a minimap in the bottom-right corner (every node
 as a small box, the visible part of the graph as a frame; click or drag in it
-to pan) and the hint shown while the document has no node.
+to pan), shown while some node is off screen or under it, and the hint shown
+while the document has no node.
 
 Both are plain widgets over the graph view, children of the editor. They are
 refreshed cheaply: the scene's ``changed`` signal and the view's repaints only
@@ -95,11 +96,20 @@ class NodeMinimap(QtWidgets.QWidget):
         """Redraw if the nodes or the visible rectangle changed; update the hint."""
         self.hint.refresh()
         nodes = self.node_rects()
-        self.setVisible(bool(nodes))
+        self.setVisible(bool(nodes) and not self._all_in_view(nodes))
         state = (tuple(_rect_tuple(r) for r in nodes), _rect_tuple(self.visible_scene_rect()))
         if state != self._state:
             self._state = state
             self.update()
+
+    def _all_in_view(self, nodes: list[QtCore.QRectF]) -> bool:
+        """Every node is in the view and clear of the minimap's corner: nothing to find,
+        so the minimap stays out of the way (it shows as soon as a node is off screen)."""
+        viewer = self.editor.graph.viewer()
+        visible = self.visible_scene_rect()
+        corner = QtCore.QRect(viewer.viewport().mapFrom(self.editor, self.geometry().topLeft()), self.size())
+        covered = viewer.mapToScene(corner).boundingRect()
+        return all(visible.contains(r) and not covered.intersects(r) for r in nodes)
 
     def _transform(self) -> tuple[float, float, float]:
         """(scale, dx, dy): scene -> minimap pixels, the whole graph and view fitted."""

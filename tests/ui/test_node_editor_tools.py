@@ -166,11 +166,10 @@ def test_fit_view_shows_every_node_of_a_large_graph(window, qtbot):
 def test_minimap_click_pans_the_editor(window, qtbot):
     ids = _grid(window, n=12, cols=4)
     editor = window.editor
-    editor.minimap.refresh()
-    assert not editor.minimap.isHidden()
     viewer = editor.graph.viewer()
     viewer.reset_zoom(QtCore.QPointF(0, 0))                # 1:1 around the first node
     editor.minimap.refresh()
+    assert not editor.minimap.isHidden()                     # nodes off screen: the minimap shows
     far = editor.scene_node(ids[-1]).view.sceneBoundingRect().center()
     assert not _visible(window).contains(far)
     s, dx, dy = editor.minimap._transform()
@@ -180,6 +179,19 @@ def test_minimap_click_pans_the_editor(window, qtbot):
     centre = _visible(window).center()
     assert abs(centre.x() - target.x()) < 2 / s and abs(centre.y() - target.y()) < 2 / s
     assert _visible(window).contains(far)
+
+
+def test_minimap_stays_out_of_the_way_while_every_node_is_in_view(window, qtbot):
+    ids = _grid(window, n=3, cols=3)
+    editor, mm = window.editor, window.editor.minimap
+    window.act_fit.trigger()
+    mm.refresh()
+    visible = _visible(window)
+    assert all(visible.contains(editor.scene_node(n).view.sceneBoundingRect()) for n in ids)
+    assert mm.isHidden()                                     # three nodes in a row, centred: all in view
+    editor.graph.viewer().reset_zoom(QtCore.QPointF(-3000.0, -3000.0))   # look away from the graph
+    mm.refresh()
+    assert not mm.isHidden()
 
 
 def test_minimap_redraws_only_when_something_changed(window, qtbot):
