@@ -58,6 +58,7 @@ class NodeEditor(QtWidgets.QWidget):
         self._by_id: dict[str, BaseNode] = {}   # engine id -> scene node
         self._id_of: dict[str, str] = {}        # scene node id -> engine id
         self._statuses: dict[str, Any] = {}
+        self.scene_rebuilds = 0                  # whole-scene rebuilds (a document reset), for tests
         self._selected: str | None = None
 
         self.graph = DocumentNodeGraph(self)
@@ -188,13 +189,22 @@ class NodeEditor(QtWidgets.QWidget):
             self.rebuild()
 
     def rebuild(self) -> None:
-        """Drop the whole scene and draw the document anew."""
-        for nid in list(self._by_id):
-            self._remove_scene_node(nid)
-        self._statuses.clear()
-        for nid in self.doc.nodes:
-            self._add_scene_node(nid)
-        self.sync_edges()
+        """Drop the whole scene and draw the document anew: the view is not repainted
+        while the nodes go and come, only once at the end (``scene_rebuilds`` counts)."""
+        viewer = self.graph.viewer()
+        was_enabled = viewer.updatesEnabled()
+        viewer.setUpdatesEnabled(False)
+        try:
+            for nid in list(self._by_id):
+                self._remove_scene_node(nid)
+            self._statuses.clear()
+            for nid in self.doc.nodes:
+                self._add_scene_node(nid)
+            self.sync_edges()
+        finally:
+            viewer.setUpdatesEnabled(was_enabled)
+        self.scene_rebuilds += 1
+        viewer.viewport().update()
         self._emit_selection()
 
     def _add_scene_node(self, node_id: str) -> None:
@@ -202,12 +212,13 @@ class NodeEditor(QtWidgets.QWidget):
             return
         inst = self.doc.nodes[node_id]
         cls = self._node_classes[inst.type_name]
-        node = self.graph.create_node(cls.type_, name=self._display_name(node_id), selected=False,
-                                      pos=list(inst.position), push_undo=False)
         family = all_node_types()[inst.type_name].family
-        node.set_property("text_color", (245, 245, 245, 255), push_undo=False)
+        # colours given at creation: the item is laid out and drawn once, not once per colour
+        node = self.graph.create_node(cls.type_, name=self._display_name(node_id), selected=False,
+                                      color=(*family_shade(family, 0.62), 255),
+                                      text_color=(245, 245, 245, 255),
+                                      pos=list(inst.position), push_undo=False)
         node.set_property("border_color", (*family_shade(family, 1.0), 255), push_undo=False)
-        node.set_property("color", (*family_shade(family, 0.62), 255), push_undo=False)
         self._by_id[node_id] = node
         self._id_of[node.id] = node_id
         self._update_tooltip(node_id)
@@ -335,14 +346,18 @@ class NodeEditor(QtWidgets.QWidget):
     def arrange_nodes(self, *, column_width: float | None = None,
                       row_height: float | None = None) -> bool:
         """Lay the graph out in readable columns (depth from the sources, rows ordered to
-        cross fewer edges, spacing from the largest node); one undoable "arrange nodes"
-        step, then the view fits the graph.  False if nothing moved."""
+        cross fewer edges, spacing from the largest node), wrapped into bands that fit the
+        editor's view best; one undoable "arrange nodes" step, then the view fits the
+        graph.  False if nothing moved."""
         rects = [n.view.boundingRect() for n in self._by_id.values()]
         if column_width is None:
             column_width = max([240.0] + [r.width() + 70.0 for r in rects])
         if row_height is None:
             row_height = max([110.0] + [r.height() + 30.0 for r in rects])
-        positions = arrange_positions(self.doc, column_width=column_width, row_height=row_height)
+        size = self.graph.viewer().viewport().size()
+        node_size = (max([180.0] + [r.width() for r in rects]), max([80.0] + [r.height() for r in rects]))
+        positions = arrange_positions(self.doc, column_width=column_width, row_height=row_height,
+                                      view=(max(size.width(), 200), max(size.height(), 200)), node_size=node_size)
         moves = [MoveNode(nid, pos) for nid, pos in positions.items()
                  if tuple(self.doc.nodes[nid].position) != pos]
         if not moves:

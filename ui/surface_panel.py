@@ -193,8 +193,12 @@ class SurfacePanel(QtWidgets.QWidget):
         self.params_box = QtWidgets.QWidget()
         self.form = QtWidgets.QFormLayout(self.params_box)
         self.form.setFieldGrowthPolicy(QtWidgets.QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
-        self.param_form = ParamForm(self.doc, self.undo, self.form, self)
-        self.param_form.message.connect(self.message.emit)
+        # the form is built when its tab shows (or a test asks for it): a hidden dock builds none
+        self._param_form = ParamForm(self.doc, self.undo, self.form, self)
+        self._param_form.message.connect(self.message.emit)
+        self._form_pending = False
+        self.form_builds = 0
+        self.params_box.installEventFilter(self)
         params = QtWidgets.QScrollArea()
         params.setWidgetResizable(True)
         params.setFrameShape(QtWidgets.QFrame.Shape.NoFrame)
@@ -351,20 +355,43 @@ class SurfacePanel(QtWidgets.QWidget):
 
     # -- parameter editors -------------------------------------------------------------------
     @property
+    def param_form(self) -> ParamForm:
+        """The shown node's parameter form (built now if it waits)."""
+        self._flush_form()
+        return self._param_form
+
+    @property
     def editors(self) -> dict:
         return self.param_form.editors
 
     def _build_editors(self) -> None:
-        node_type = self.doc.nodes[self.node_id].type_name if self.node_id is not None else None
+        self._form_pending = True
+        if self.params_box.isVisible():
+            self._flush_form()
+
+    def _flush_form(self) -> None:
+        if not self._form_pending:
+            return
+        self._form_pending = False
+        self.form_builds += 1
+        node_id = self.node_id if self.node_id in self.doc.nodes else None
+        node_type = self.doc.nodes[node_id].type_name if node_id is not None else None
         params = all_node_types()[node_type].params if node_type is not None else ()
-        self.param_form.show_node(self.node_id, params)
+        self._param_form.show_node(node_id, params)
         self._update_visibility()
 
     def _update_visibility(self) -> None:
-        params = self.doc.nodes[self.node_id].params if self.node_id else {}
-        for name in self.param_form.editors:
+        if self._form_pending:
+            return                              # built with the right rows when it shows
+        params = self.doc.nodes[self.node_id].params if self.node_id in self.doc.nodes else {}
+        for name in self._param_form.editors:
             other, values = SHOWN_WHEN.get(name, (None, None))
-            self.param_form.set_row_visible(name, other is None or params.get(other) in values)
+            self._param_form.set_row_visible(name, other is None or params.get(other) in values)
+
+    def eventFilter(self, watched, event) -> bool:
+        if watched is self.params_box and event.type() == QtCore.QEvent.Type.Show:
+            self._flush_form()
+        return super().eventFilter(watched, event)
 
     def editor_widget(self, name: str) -> QtWidgets.QWidget:
         """The input widget of parameter ``name`` (tests drive it like a user would)."""
@@ -391,8 +418,8 @@ class SurfacePanel(QtWidgets.QWidget):
         elif event == "param_changed":
             nid, name = payload
             self._stale.add(nid)
-            if nid == self.node_id:
-                self.param_form.on_param_changed(nid, name)
+            if nid == self.node_id and not self._form_pending:
+                self._param_form.on_param_changed(nid, name)
                 self._update_visibility()
             sid = source_surface(self.doc, self.node_id) if self.node_id else None
             if self.node_id is not None and nid in (self.node_id, sid):
@@ -401,5 +428,7 @@ class SurfacePanel(QtWidgets.QWidget):
                     self._show_loop(sid)        # what slides follows the solver
 
     def shutdown(self) -> None:
-        """Stop following the document (the window is closing)."""
+        """Stop following the document and drawing (the window is closing)."""
         self.doc.unsubscribe(self._on_doc_event)
+        self.chart.shutdown()
+        self.schematic.shutdown()

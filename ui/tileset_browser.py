@@ -1,4 +1,9 @@
-"""The tile-set browser of the Tile Sets dock: shipped and user sets in a tree."""
+"""The tile-set browser of the Tile Sets dock: shipped and user sets in a tree.
+
+Reading the folders (every set file is parsed) is lazy: :meth:`TileSetBrowser.refresh`
+only notes what to list while the browser is hidden, and the list is read when it
+is shown or a row is asked for (``fills`` counts the readings).
+"""
 
 from __future__ import annotations
 
@@ -19,9 +24,29 @@ class TileSetBrowser(QtWidgets.QTreeWidget):
         super().__init__(parent)
         self.setHeaderLabels(["Tile set", "dim", "blocks"])
         self.setRootIsDecorated(True)
+        self.fills = 0
+        self._wanted: tuple[Path, object] | None = None
 
     def refresh(self, folder: Path, current=None) -> None:
-        """List the shipped sets and those in ``folder``; select the file ``current``."""
+        """List the shipped sets and those in ``folder``; select the file ``current``
+        (now if the browser is visible, else when it is shown or a row is asked for)."""
+        self._wanted = (Path(folder), current)
+        if self.isVisible():
+            self.ensure_listed()
+
+    def ensure_listed(self) -> None:
+        """Read the folders now if a refresh waits."""
+        if self._wanted is not None:
+            folder, current = self._wanted
+            self._wanted = None
+            self._fill(folder, current)
+
+    def showEvent(self, event: QtGui.QShowEvent) -> None:
+        super().showEvent(event)
+        self.ensure_listed()
+
+    def _fill(self, folder: Path, current) -> None:
+        self.fills += 1
         self.blockSignals(True)
         self.clear()
         groups = {True: QtWidgets.QTreeWidgetItem(["Shipped"]),
@@ -43,6 +68,7 @@ class TileSetBrowser(QtWidgets.QTreeWidget):
 
     def item_named(self, name: str) -> QtWidgets.QTreeWidgetItem | None:
         """The row of the set called ``name`` (shipped first)."""
+        self.ensure_listed()
         flags = QtCore.Qt.MatchFlag.MatchExactly | QtCore.Qt.MatchFlag.MatchRecursive
         rows = [i for i in self.findItems(name, flags, 0) if i.data(0, PATH_ROLE)]
         return rows[0] if rows else None

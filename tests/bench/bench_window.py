@@ -4,7 +4,8 @@ Run: xvfb-run -s "-screen 0 1920x1080x24" .venv/bin/python tests/bench/bench_win
      [--examples octet tpms_schwarz_p] [--frames 20]
 
 For each example: with a 20 ms QTimer heartbeat on the GUI thread record
-the longest gap between ticks while (a) it is opened in a real MainWindow,
+the longest gap between ticks while (0) the window starts (its docks' first draws,
+kept apart from the example's), (a) it is opened in a real MainWindow,
 evaluated and drawn, (b) every node is selected in turn, (c) View > Tile
 3x3x3 is switched on until the tiled mesh is drawn ("first frame") and off
 and on again, (d) the 3x3x3 block is exported as STL; at each tiling rotate
@@ -12,7 +13,9 @@ the camera --frames times, once as still frames (render() calls) and once as
 a mouse drag through the VTK interactor (the level of detail for a moving
 camera), and print frames/s.  Prints
 a table; asserts nothing and leaves no file (the export goes to a
-temporary folder and is deleted).  Compare with the figures in
+temporary folder and is deleted).  --sample adds, under each stall row, the
+GUI thread's commonest stacks during its longest gaps over 50 ms
+(tests/bench/stall_sampler.py); --quick stops after the selections.  Compare with the figures in
 issue #14 (before: 1.6-2.9 s per selection, 18.5 s for the 3x3x3 toggle,
 12-13 s per rotation frame on the 3x3x3 octet).
 """
@@ -35,6 +38,10 @@ from PySide6 import QtCore, QtWidgets  # noqa: E402
 from app.gui import create_main_window  # noqa: E402
 from ui.main_window import EXAMPLES_DIR  # noqa: E402
 from ui.qt_wait import process_events_until  # noqa: E402
+from stall_sampler import StallSampler  # noqa: E402  (this folder is on sys.path)
+
+QUICK = False           # --quick: stop after the selections (no rotation, tiling, export)
+SAMPLE = False          # --sample: print where the GUI thread was during gaps > 50 ms
 
 
 class Heartbeat:
@@ -57,11 +64,20 @@ class Heartbeat:
     def __enter__(self):
         self.last, self.longest, self.ticks = time.perf_counter(), 0.0, 0
         self.timer.start()
+        self.sampler = StallSampler(self).__enter__() if SAMPLE else None
         return self
 
     def __exit__(self, *exc):
         self._tick()
         self.timer.stop()
+        if self.sampler is not None:
+            self.sampler.__exit__()
+
+    def where(self) -> list[tuple[str, str]]:
+        """Rows for the sampled gaps (empty without --sample)."""
+        if self.sampler is None:
+            return []
+        return [(line, "") for line in self.sampler.report()]
 
 
 def pump(done, timeout_ms=600000):
@@ -105,8 +121,12 @@ def bench(name: str, frames: int) -> list[tuple[str, str]]:
     window = create_main_window(autosave_dir=tempfile.mkdtemp())
     window.resize(1400, 850)
     window.show()
-    pump(lambda: window.isVisible(), 5000)
     rows = []
+    with Heartbeat() as hb:
+        pump(lambda: window.isVisible(), 5000)
+        pump(lambda: False, 1500)            # the docks' first layout and draws (not the example's)
+    rows.append(("window start (empty docks drawn): longest stall (ms)", f"{1000 * hb.longest:.0f}"))
+    rows += hb.where()
     try:
         after = window.eval_count
         vp = window.viewport
@@ -115,12 +135,14 @@ def bench(name: str, frames: int) -> list[tuple[str, str]]:
             window.open_example(EXAMPLES_DIR / f"{name}.json", ask=False)
             pump(lambda: False, 1500)        # the document's docks and editor settle (not the viewport's work)
         rows.append(("open example (docks, editor): longest stall (ms)", f"{1000 * hb.longest:.0f}"))
+        rows += hb.where()
         with Heartbeat() as hb:
             window.evaluate_now()
             pump(lambda: window.eval_count > after and window.evaluation_idle)
             t0 = time.perf_counter()
             pump(lambda: vp.is_ready)
         rows.append(("evaluate + prepare + draw: longest stall (ms)", f"{1000 * hb.longest:.0f}"))
+        rows += hb.where()
         rows.append(("all levels ready after evaluation (s)", f"{time.perf_counter() - t0:.2f}"))
         rows.append(("solid points / triangles (1 cell)", f"{vp.mesh_point_count():,} / {len(vp.solid.faces):,}"))
         rows.append(("  level triangles", " ".join(f"{m.n_cells}" for m in vp.solid_view().meshes)))
@@ -129,7 +151,10 @@ def bench(name: str, frames: int) -> list[tuple[str, str]]:
                 window.editor.select(nid)
                 pump(lambda: vp.is_ready)
         rows.append((f"select {len(window.doc.nodes)} nodes: longest stall (ms)", f"{1000 * hb.longest:.0f}"))
+        rows += hb.where()
         rows.append(("  solid actor swaps / full rebuilds", f"{vp.scene.replaced['solid']} / {vp.scene.full_rebuilds}"))
+        if QUICK:
+            return rows
         rows.append(("rotation 1x1x1, still frames (frames/s)", f"{rotation_fps(window, frames):.1f}"))
         fps, release, drawn = drag_fps(window, frames)
         rows.append(("rotation 1x1x1, drag (frames/s)", f"{fps:.1f}"))
@@ -177,14 +202,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--examples", nargs="+", default=["octet", "tpms_schwarz_p", "tpms_gyroid"])
     parser.add_argument("--frames", type=int, default=20)
+    parser.add_argument("--sample", action="store_true",
+                        help="print the GUI thread's commonest stacks during gaps over 50 ms")
+    parser.add_argument("--quick", action="store_true",
+                        help="only open, evaluate and select (no rotation, tiling or export)")
     args = parser.parse_args()
+    global SAMPLE, QUICK
+    SAMPLE, QUICK = args.sample, args.quick
     os.environ.setdefault("MESOFORGE_AUTOSAVE_DIR", tempfile.mkdtemp())
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv)
     print(f"# bench_window on {platform.machine()} {platform.system()}, Python {platform.python_version()}")
     for name in args.examples:
         print(f"\n## {name}")
         for label, value in bench(name, args.frames):
-            print(f"{label:<52} {value:>12}")
+            print(f"{label:<52} {value:>12}" if value else label)
     app.processEvents()
 
 

@@ -47,6 +47,7 @@ def test_schwarz_p_report_chart_and_loop_show_in_the_dock(window, wait_eval, eng
     history = panel.chart.history
     assert history.size >= 2 and np.all(np.isfinite(history))
     assert history[-1] == pytest.approx(float(panel.report_labels["energy"].text()), rel=1e-5)
+    panel.chart.ensure_drawn()         # a hidden dock's chart is laid out only when shown
     assert len(panel.chart.axes.lines) >= 1 and len(panel.chart.axes.lines[0].get_ydata()) == history.size
     # the hexagon in its best-fit plane: six vertices, every segment slides for a conjugate solve
     assert panel.schematic.points2d.shape == (6, 2)
