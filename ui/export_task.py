@@ -113,7 +113,13 @@ class MeshExport(QtCore.QObject):
         self.runner.cancelled.connect(self._on_cancelled)
         self.outcome: str | None = None
         self.progress_seen = 0                  # progress reports received (tests)
-        self.box = QtWidgets.QWidget()
+        # A child of the status bar placed over its right end, outside its layout:
+        # showing or hiding it relayouts nothing, so the viewport is not resized
+        # and re-rendered (100-200 ms on llvmpipe, on the GUI thread).
+        self._status_bar = status_bar
+        self.box = QtWidgets.QWidget(status_bar)
+        self.box.hide()
+        self.box.setAutoFillBackground(True)
         row = QtWidgets.QHBoxLayout(self.box)
         row.setContentsMargins(0, 0, 0, 0)
         self.bar = QtWidgets.QProgressBar()
@@ -125,8 +131,21 @@ class MeshExport(QtCore.QObject):
         self.cancel_button.clicked.connect(self.cancel)
         row.addWidget(self.bar)
         row.addWidget(self.cancel_button)
-        status_bar.addPermanentWidget(self.box)
-        self.box.hide()
+        status_bar.installEventFilter(self)
+
+    def eventFilter(self, obj, event):  # noqa: N802 (Qt's name)
+        if obj is self._status_bar and event.type() == QtCore.QEvent.Type.Resize and self.box.isVisible():
+            self._place()
+        return False
+
+    def _place(self) -> None:
+        sb = self._status_bar
+        h = max(1, sb.height() - 2)
+        for w in (self.bar, self.cancel_button):
+            w.setMaximumHeight(h)
+        self.box.adjustSize()
+        self.box.setGeometry(max(0, sb.width() - self.box.width() - 20), (sb.height() - h) // 2,
+                             self.box.width(), h)
 
     @property
     def busy(self) -> bool:
@@ -135,7 +154,9 @@ class MeshExport(QtCore.QObject):
     def start(self, solid, tiles: tuple, path: Path) -> Task:
         self.outcome = None
         self.bar.setValue(0)
+        self._place()
         self.box.show()
+        self.box.raise_()
         return self.runner.submit(lambda task: write_mesh(task, solid, tiles, path), data=(path, tiles))
 
     def wait(self, timeout_ms: int = 600000) -> bool:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .box_cell import check_cell
+from .slab_marching import slab_marching_cubes
 from engine.progress import report
 
 __all__ = ["periodic_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
@@ -109,10 +110,7 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None
     # crossings are clipped back onto the box faces below.
     pad = 1 if closed else 0
     axes = [np.arange(f.shape[a] * t[a] + 1) % f.shape[a] for a in range(3)]
-    grid = np.full([len(ax) + 2 * pad for ax in axes], lv32 + np.float32(10.0 * (spread + 1.0)),
-                   dtype=np.float32)
-    inner = tuple(slice(pad, grid.shape[a] - pad) for a in range(3))
-    grid[inner] = f[np.ix_(*axes)]
+    grid = tiled_grid(f, axes, pad, lv32 + np.float32(10.0 * (spread + 1.0)))
 
     verts, faces = slab_marching_cubes(grid, float(lv32), progress)
     spacing = cs * box / np.array(f.shape, dtype=np.float64)
@@ -129,6 +127,28 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None
     return verts, faces
 
 
+def tiled_grid(f, axes, pad, outside, planes=8):
+    """The tiled grid ``f[np.ix_(*axes)]`` inside ``pad`` layers of ``outside``.
+
+    Filled a few x planes at a time: one gather over the whole block (58 M
+    samples for 3 x 3 x 3 cells of 128^3) would hold the GIL for a long stretch.
+    """
+    shape = [len(ax) + 2 * pad for ax in axes]
+    grid = np.empty(shape, dtype=np.float32)
+    if pad:
+        grid[:pad] = outside
+        grid[shape[0] - pad:] = outside
+    for i0 in range(0, len(axes[0]), planes):
+        sub = grid[pad + i0:pad + min(i0 + planes, len(axes[0]))]
+        if pad:
+            sub[:, :pad] = outside
+            sub[:, shape[1] - pad:] = outside
+            sub[:, :, :pad] = outside
+            sub[:, :, shape[2] - pad:] = outside
+        sub[:, pad:shape[1] - pad, pad:shape[2] - pad] = f[np.ix_(axes[0][i0:i0 + planes], axes[1], axes[2])]
+    return grid
+
+
 def drop_specks(vertices, faces, min_volume):
     """Remove closed pieces enclosing less than ``min_volume`` (absolute).
 
@@ -138,77 +158,31 @@ def drop_specks(vertices, faces, min_volume):
     real geometry.  Whole closed pieces are dropped, so a watertight mesh
     stays watertight.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    from .mesh_components import vertex_components
+    from .slab_marching import CHUNK_ROWS, compress_rows, index_of_kept, take_chunked
 
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     if f.shape[0] == 0:
         return v, f
     n = v.shape[0]
-    rows = np.concatenate([f[:, 0], f[:, 1], f[:, 2]])
-    cols = np.concatenate([f[:, 1], f[:, 2], f[:, 0]])
-    adj = coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
-    count, label = connected_components(adj, directed=False)
+    count, label = vertex_components(f, n)
     if count == 1:
         return v, f
-    tri = v[f]
-    vol6 = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
-    piece_volume = np.abs(np.bincount(label[f[:, 0]], weights=vol6, minlength=count)) / 6.0
-    keep_face = piece_volume[label[f[:, 0]]] >= min_volume
+    # in chunks of faces: each numpy call below is short (the results are row-wise)
+    vol6 = np.empty(f.shape[0])
+    for r0 in range(0, f.shape[0], CHUNK_ROWS):
+        tri = v[f[r0:r0 + CHUNK_ROWS]]
+        vol6[r0:r0 + CHUNK_ROWS] = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
+    face_label = take_chunked(label, f[:, 0])
+    piece_volume = np.abs(np.bincount(face_label, weights=vol6, minlength=count)) / 6.0
+    keep_face = piece_volume[face_label] >= min_volume
     if keep_face.all():
         return v, f
-    f = f[keep_face]
+    f = compress_rows(f, keep_face)
     used = np.zeros(n, dtype=bool)
     used[f.ravel()] = True
-    return v[used], (np.cumsum(used) - 1)[f]
-
-
-# Planes per slab: small enough that one slab of a 256^3 grid meshes in well
-# under the ~100 ms a cancel may take, large enough to keep overhead low.
-_SLAB_CELLS = 24
-
-
-def slab_marching_cubes(grid, level, progress):
-    """Marching cubes over slabs along x, welded on the shared planes.
-
-    Slabs share their boundary plane of samples, so the vertices on it are
-    computed from the same edge samples by both slabs and are bitwise equal;
-    the Lewiner face-ambiguity test depends on face samples only, so both
-    sides triangulate the shared face alike.  Welding those equal vertices
-    gives exactly the mesh of one call, with progress and cancel between slabs.
-    """
-    from skimage.measure import marching_cubes
-
-    n0 = grid.shape[0]
-    starts = list(range(0, n0 - 1, _SLAB_CELLS))
-    report(progress, 0, len(starts))
-    all_v, all_f, base = [], [], 0
-    for k, i0 in enumerate(starts):
-        i1 = min(i0 + _SLAB_CELLS, n0 - 1)
-        block = grid[i0:i1 + 1]
-        if (block < level).any() and (block > level).any():
-            v, f, _, _ = marching_cubes(block, level=level, gradient_direction="descent", allow_degenerate=True)
-            v[:, 0] += i0
-            all_v.append(v)
-            all_f.append(f + base)
-            base += v.shape[0]
-        report(progress, k + 1, len(starts))
-    if not all_v:
-        return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.int64)
-    verts = np.concatenate(all_v)
-    faces = np.concatenate(all_f).astype(np.int64)
-    if len(all_v) == 1:
-        return verts, faces
-    on_plane = np.isin(verts[:, 0], np.array(starts[1:], dtype=verts.dtype))
-    cand = np.flatnonzero(on_plane)
-    _, first, inverse = np.unique(verts[cand], axis=0, return_index=True, return_inverse=True)
-    remap = np.arange(verts.shape[0])
-    remap[cand] = cand[first][inverse.ravel()]
-    faces = remap[faces]
-    used = np.zeros(verts.shape[0], dtype=bool)
-    used[faces.ravel()] = True
-    return verts[used], (np.cumsum(used) - 1)[faces]
+    return take_chunked(v, np.flatnonzero(used)), take_chunked(index_of_kept(used), f)
 
 
 def weld_clipped(verts, faces, extent):
@@ -228,15 +202,16 @@ def weld_clipped(verts, faces, extent):
     _, first, inverse = np.unique(verts[cand], axis=0, return_index=True, return_inverse=True)
     if first.size == cand.size:
         return verts, faces
+    from .slab_marching import compress_rows, index_of_kept, take_chunked
+
     remap = np.arange(verts.shape[0])
     remap[cand] = cand[first][inverse.ravel()]
-    faces = remap[faces]
+    faces = take_chunked(remap, faces)
     keep = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])
-    faces = faces[keep]
+    faces = compress_rows(faces, keep)
     used = np.zeros(verts.shape[0], dtype=bool)
     used[faces.ravel()] = True
-    new_index = np.cumsum(used) - 1
-    return verts[used], new_index[faces]
+    return take_chunked(verts, np.flatnonzero(used)), take_chunked(index_of_kept(used), faces)
 
 
 def mesh_volume(vertices, faces):

@@ -54,10 +54,15 @@ def export_mesh(vertices, faces, path):
         Ends in .stl (binary), .obj, .ply (binary) or .3mf (any case). The
         directory must exist; an existing file is replaced atomically.
     """
-    import trimesh
-
     suffix = _suffix(path)
     v, f = _check_mesh(vertices, faces)
+    if suffix == ".stl":          # chunked, trimesh's bytes (engine.geometry.stl_encode)
+        from .stl_encode import binary_stl
+
+        write_atomic(path, binary_stl(v, f))
+        return
+    import trimesh
+
     data = trimesh.Trimesh(v, f, process=False).export(file_type=suffix[1:])
     if isinstance(data, str):
         data = data.encode("utf-8")

@@ -81,8 +81,11 @@ def boundary_flags(faces, vertex_count):
     f = np.asarray(faces, dtype=np.int64)
     # Edge opposite corner k joins the other two corners.
     edges = np.stack([f[:, [1, 2]], f[:, [2, 0]], f[:, [0, 1]]], axis=1).reshape(-1, 2)
-    key = np.sort(edges, axis=1)
-    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    # one int64 per undirected edge: a 1-D sort, where np.unique over rows
+    # sorts a void view holding the GIL for the whole call
+    n = max(int(vertex_count), int(f.max()) + 1 if f.size else 0, 1)
+    key = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
+    _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
     edge_boundary = (counts[inverse.ravel()] == 1).reshape(-1, 3)
     vertex_boundary = np.zeros(vertex_count, dtype=bool)
     vertex_boundary[edges[edge_boundary.ravel()].ravel()] = True
