@@ -10,32 +10,16 @@ from __future__ import annotations
 import threading
 
 import pytest
-from PySide6 import QtCore
 
 import engine.geometry.mesh_io as mesh_io
 import ui.export_task as export_task
 from app.cli import main as cli_main
 
+from heartbeat import Heartbeat
+
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 HEARTBEATS_WHILE_EXPORTING = 5
-
-
-class Heartbeat:
-    """Ticks of a 20 ms timer on the GUI thread."""
-
-    def __init__(self):
-        self.ticks = 0
-        self.timer = QtCore.QTimer()
-        self.timer.setInterval(20)
-        self.timer.timeout.connect(self._tick)
-        self.timer.start()
-
-    def _tick(self):
-        self.ticks += 1
-
-    def stop(self):
-        self.timer.stop()
 
 
 @pytest.fixture

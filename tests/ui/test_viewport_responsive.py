@@ -13,33 +13,17 @@ import threading
 
 import numpy as np
 import pytest
-from PySide6 import QtCore
 
 import ui.scene_lod as scene_lod
 import ui.viewport as viewport_module
 import ui.viewport_solid as viewport_solid
 from ui.main_window import EXAMPLES_DIR
 
+from heartbeat import Heartbeat
+
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 HEARTBEATS_WHILE_PREPARING = 5
-
-
-class Heartbeat:
-    """Ticks of a 20 ms timer on the GUI thread."""
-
-    def __init__(self):
-        self.ticks = 0
-        self.timer = QtCore.QTimer()
-        self.timer.setInterval(20)
-        self.timer.timeout.connect(self._tick)
-        self.timer.start()
-
-    def _tick(self):
-        self.ticks += 1
-
-    def stop(self):
-        self.timer.stop()
 
 
 @pytest.fixture
