@@ -15,7 +15,10 @@ on screen, the number of copies and whether the camera is moving:
 * within budget: the copies in view together draw at most `STILL_BUDGET`
   triangles (or one full cell, if that is more; a single cell in view is
   exempt: its full mesh is always allowed) or, while the camera moves,
-  `MOVING_BUDGET`.
+  `MOVING_BUDGET`;
+* a translucent solid (drawn faint behind the skeleton it was made from)
+  keeps to `MOVING_BUDGET` even when still: its facets cannot be told apart
+  through the blending, and a blended frame costs more per triangle.
 
 Plain numpy / pyvista, no Qt and no render window.
 """
@@ -80,12 +83,14 @@ def build_levels(vertices: np.ndarray, faces: np.ndarray, check: Callable[[], No
         yield tuple(levels)
 
 
-def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: bool) -> tuple[int, bool]:
+def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: bool,
+               translucent: bool = False) -> tuple[int, bool]:
     """(index into `counts`, fits): the level to draw.
 
     counts : triangles of each available level (any order)
     copies : cells in view (of 1 or 27 drawn)
     cell_pixels : the cell's longest edge on screen, pixels
+    translucent : the solid is blended (opacity < 1): kept to the moving budget
     fits : False if even the coarsest level is over the budget (the caller may then
         draw fewer copies until a coarser level is made)."""
     order = sorted(range(len(counts)), key=lambda i: counts[i])      # coarse -> fine
@@ -93,7 +98,7 @@ def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: b
     enough = next((i for i in order if counts[i] >= wanted), order[-1])
     if copies == 1 and not moving:
         enough = order[-1]                   # one cell in view, camera still: the full mesh
-    budget = MOVING_BUDGET if moving else (math.inf if copies == 1 else max(STILL_BUDGET, max(counts)))
+    budget = MOVING_BUDGET if moving or translucent else (math.inf if copies == 1 else max(STILL_BUDGET, max(counts)))
     allowed = [i for i in order if copies * counts[i] <= budget and counts[i] <= counts[enough]]
     if allowed:
         return allowed[-1], True

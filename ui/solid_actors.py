@@ -10,7 +10,8 @@ actors share one property (colour, opacity).
 Before every frame (`choose`, called from the renderer's StartEvent) the
 level is picked from the cell's size on screen and whether the camera is
 moving (the interactor raises the render window's desired update rate while a
-drag, wheel or key moves the camera and lowers it when it stops).
+drag, wheel or key moves the camera and lowers it when it stops) and whether
+the shared property is translucent.
 """
 
 from __future__ import annotations
@@ -115,7 +116,8 @@ class SolidActors:
             moving = window is not None and window.GetDesiredUpdateRate() >= MOVING_RATE
         counts = [m.n_cells for m in self.meshes]
         self.in_view = self.copies_in_view()
-        level, fits = pick_level(counts, max(1, self.in_view), self.cell_pixels(), moving)
+        level, fits = pick_level(counts, max(1, self.in_view), self.cell_pixels(), moving,
+                                 translucent=self.prop.GetOpacity() < 1.0)
         self.last_moving, self.last_level = moving, counts[level]
         # a tiling no level fits yet (the coarse levels are being made): only the middle tile
         self.partial = not fits and not self.complete and len(self.offsets) > 1

@@ -299,7 +299,9 @@ class StudyPanel(QtWidgets.QWidget):
             self._process.kill()
 
     def shutdown(self, timeout_ms: int = 5000) -> None:
-        """Stop a running study and wait for its process (call before the window closes)."""
+        """Stop a running study and wait for its process, and the plots' draw threads
+        (call before the window closes)."""
+        self.plots.shutdown()
         proc = self._process
         if proc is None:
             return

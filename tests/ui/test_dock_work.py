@@ -6,7 +6,9 @@
 * opening an example rebuilds the node editor's scene once, with no repaint of the
   graph view while its nodes are added;
 * the Tile Sets browser reads the set folders only when it is shown or a row is
-  asked for.
+  asked for;
+* the Studies dock's three figures likewise draw only the visible tab, off the
+  GUI thread (a window starts without drawing any of them).
 """
 
 from __future__ import annotations
@@ -132,3 +134,34 @@ def test_hidden_surfaces_dock_builds_its_parameter_form_only_when_shown(window, 
     qtbot.waitUntil(lambda: panel.params_box.isVisible())
     assert panel.form_builds == builds + 1
     assert "type" in panel.editors                      # the Surface's own parameters
+
+
+def _study_draws(plots) -> list[int]:
+    return [c.draws for c in (plots.scatter_canvas, plots.pies_canvas, plots.polar_canvas)]
+
+
+def test_studies_dock_draws_only_its_visible_tab(window, qtbot):
+    plots = window.study_panel.plots
+    window.study_dock.hide()
+    qtbot.waitUntil(lambda: not plots.isVisible())
+    qtbot.wait(50)
+    start = _study_draws(plots)
+    assert start[1:] == [0, 0]                          # at most the tab on top was drawn at start
+    for _ in range(3):
+        plots.show_rows([])                              # new rows while hidden: kept, not drawn
+    assert _study_draws(plots) == start
+
+    window.study_dock.show()
+    window.study_dock.raise_()
+    plots.tabs.setCurrentIndex(0)
+    qtbot.waitUntil(lambda: plots.scatter_canvas.drawn > 0, timeout=20000)
+    qtbot.wait(50)
+    assert _study_draws(plots) == [start[0] + 1, 0, 0]  # the newest rows, once
+    texts = [t.get_text() for t in plots.scatter_canvas.axes.texts]
+    assert texts == ["no study rows yet"]
+
+    plots.tabs.setCurrentIndex(2)                        # the polar tab draws when shown
+    qtbot.waitUntil(lambda: plots.polar_canvas.drawn > 0, timeout=20000)
+    assert _study_draws(plots) == [start[0] + 1, 0, 1]
+    assert plots.polar_curve() is None                   # no rows: no curve, nothing else drawn
+    assert _study_draws(plots) == [start[0] + 1, 0, 1]

@@ -48,6 +48,14 @@ def test_a_still_tiled_view_gets_the_finest_level_the_budget_allows():
     assert LEVELS[i] == 1_481 >= TRIANGLES_PER_PIXEL * 10 ** 2
 
 
+def test_a_translucent_solid_keeps_to_the_moving_budget_when_still():
+    i, fits = pick_level(LEVELS, 1, 500, moving=False, translucent=True)
+    assert fits and LEVELS[i] == 40_000 <= MOVING_BUDGET           # not the full 123,248
+    i, fits = pick_level(LEVELS, 27, 170, moving=False, translucent=True)
+    assert fits and LEVELS[i] == 1_481 and 27 * LEVELS[i] <= MOVING_BUDGET
+    assert pick_level([123_248], 1, 500, moving=False, translucent=True) == (0, False)   # only the full mesh yet
+
+
 def test_nothing_fits_until_a_coarse_level_exists():
     assert pick_level([123_248], 27, 170, moving=False) == (0, False)
     assert pick_level([123_248, 4_444], 27, 170, moving=False) == (1, True)
@@ -99,5 +107,31 @@ def test_tiles_in_view_follow_the_frustum():
         cam.position, cam.focal_point = (0.5, 0.5, 12.0), (0.5, 0.5, 24.0)      # looking away
         plotter.renderer.ResetCameraClippingRange()
         assert view.copies_in_view() == 0
+    finally:
+        plotter.close()
+
+
+def test_tiles_follow_the_shared_property_into_translucency():
+    from ui.scene_prep import prepare_cell
+    from ui.solid_actors import SolidActors
+
+    plotter = pv.Plotter(off_screen=True, window_size=(400, 400))
+    try:
+        sphere = pv.Sphere(radius=0.5, center=(0.5, 0.5, 0.5), theta_resolution=200, phi_resolution=200)
+        cells = list(build_levels(np.asarray(sphere.points), np.asarray(sphere.regular_faces)))[-1]
+        prop = pv.Property()
+        view = SolidActors(plotter.renderer, prop, np.ones(3))
+        view.set_levels(cells, complete=True)
+        view.set_offsets(np.zeros((1, 3)))
+        plotter.camera.focal_point, plotter.camera.position = (0.5, 0.5, 0.5), (0.5, 0.5, 4.0)
+        view.choose(moving=False)
+        assert view.drawn_triangles() == len(cells[0].faces) > MOVING_BUDGET      # opaque: the full mesh
+        prop.SetOpacity(0.35)
+        view.choose(moving=False)
+        assert view.drawn_triangles() <= MOVING_BUDGET
+        assert view.drawn_triangles() == max(len(c.faces) for c in cells if len(c.faces) <= MOVING_BUDGET)
+        prop.SetOpacity(1.0)
+        view.choose(moving=False)
+        assert view.drawn_triangles() == len(cells[0].faces)
     finally:
         plotter.close()
