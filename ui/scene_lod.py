@@ -98,7 +98,10 @@ def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: b
     enough = next((i for i in order if counts[i] >= wanted), order[-1])
     if copies == 1 and not moving:
         enough = order[-1]                   # one cell in view, camera still: the full mesh
-    budget = MOVING_BUDGET if moving or translucent else (math.inf if copies == 1 else max(STILL_BUDGET, max(counts)))
+    if moving or translucent:
+        budget = MOVING_BUDGET
+    else:
+        budget = math.inf if copies == 1 else max(STILL_BUDGET, max(counts))
     allowed = [i for i in order if copies * counts[i] <= budget and counts[i] <= counts[enough]]
     if allowed:
         return allowed[-1], True

@@ -43,12 +43,13 @@ def group_label(group) -> str:
 
 
 class StudyFigure(LazyPlot):
-    """A study figure: `show(version, state)`; `artists(gid)` reads the drawn figure."""
+    """A study figure: `set_state(key, state)` (a new key draws `state`); `artists(gid)`
+    reads the drawn figure."""
 
     def __init__(self, parent=None):
         super().__init__(MIN_HEIGHT, parent)
 
-    def show(self, key: tuple, state) -> None:
+    def set_state(self, key: tuple, state) -> None:
         self._changed(PlotKey(*key), state)
 
     def artists(self, gid: str) -> list:

@@ -71,8 +71,8 @@ class StudyPlots(QtWidgets.QWidget):
         self.group_box.blockSignals(False)
         self._update_sample_range()
         self._version += 1
-        self.scatter_canvas.show((self._version,), self.groups)
-        self.pies_canvas.show((self._version,), self.groups)
+        self.scatter_canvas.set_state((self._version,), self.groups)
+        self.pies_canvas.set_state((self._version,), self.groups)
         self._draw_polar()
 
     # ------------------------------------------------------------ read back
@@ -127,7 +127,7 @@ class StudyPlots(QtWidgets.QWidget):
 
     def _draw_polar(self) -> None:
         k, i = self.group_box.currentIndex(), self.sample_spin.value()
-        self.polar_canvas.show((self._version, k, i), (self._current_group(), k, i))
+        self.polar_canvas.set_state((self._version, k, i), (self._current_group(), k, i))
 
     def shutdown(self) -> None:
         """Stop the figures' draw threads (the window is closing)."""
