@@ -8,6 +8,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.thumbnails import render_in_child
+from engine.kernel_warmup import warm_up_kernels
 from ui.dialogs import Prompter
 from ui.example_gallery import show_at_startup, show_gallery
 from ui.main_window import DEFAULT_EXAMPLE, EXAMPLES_DIR, MainWindow
@@ -27,6 +28,7 @@ def create_main_window(project_path: str | Path | None = None, autosave_dir: str
     session's autosave is offered first.  `settings` (a QSettings or an ini file's
     path) keeps the window's layout between sessions; None keeps nothing.
     """
+    warm_up_kernels()        # numba's tables now, not on a worker thread in the first evaluation (GIL)
     extra = {} if autosave_interval_ms is None else {"autosave_interval_ms": autosave_interval_ms}
     window = MainWindow(autosave_dir=autosave_dir, prompter=prompter, settings=settings, **extra)
     window.thumbnail_renderer = render_in_child    # the gallery's missing thumbnails, off the GUI thread

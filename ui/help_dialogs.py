@@ -67,7 +67,7 @@ PAPERS = (
 )
 
 LIBRARIES = ("numpy", "scipy", "scikit-image", "trimesh", "libigl", "PySide6", "NodeGraphQt", "vtk",
-             "pyvista", "pyvistaqt", "moderngl", "dask")
+             "pyvista", "moderngl", "dask")
 # distributions a library may be installed as
 _DISTRIBUTIONS = {"PySide6": ("PySide6", "PySide6-Essentials")}
 

@@ -1,22 +1,19 @@
-"""The viewport's Qt render widget: repaints that would redraw an unchanged scene only show the last frame.
+"""The viewport's render widget: repaints that would redraw an unchanged scene only show the last frame.
 
-pyvistaqt's widget renders the VTK scene in every ``paintGL``, it asks Qt
-for a repaint after every VTK render (to show the frame), and a timer renders
-the scene five times a second whatever happens.  So each render was done
-twice, any repaint of the window (a progress bar moving, a status message)
-redrew the whole scene, and an idle view kept rendering: on the software
-renderer that is 50-500 ms of GUI thread each time.  `StampedInteractor` remembers a stamp
-of everything a frame depends on (widget size, and the modification times of
-every renderer, camera, light and prop) at the end of each render; a
-``paintGL`` whose stamp is unchanged shows the frame already rendered
-(the widget's own in-paint guard skips the render) instead of rendering again,
-and the timer renders only a scene that changed without being rendered (a
-safety net for code that forgets to render).
+The viewport is a native window VTK draws into (`ui.native_view`); Qt asks
+it to paint when it is exposed or resized, and a timer renders five times a
+second whatever happens (a net for code that forgets to render).  On the
+software renderer a frame is 50-500 ms of GUI thread.  `StampedInteractor`
+remembers a stamp of everything a frame depends on (widget size, and the
+modification times of every renderer, camera, light and prop) at the end of
+each render; a paint whose stamp is unchanged puts the last frame back on
+screen (VTK keeps it in its own framebuffer) instead of rendering again, and
+the timer renders only a scene that changed without being rendered.
 """
 
 from __future__ import annotations
 
-from pyvistaqt import QtInteractor
+from .native_view import NativeInteractor
 
 
 def scene_stamp(render_window, size: tuple) -> tuple:
@@ -42,8 +39,8 @@ def scene_stamp(render_window, size: tuple) -> tuple:
     return tuple(parts)
 
 
-class StampedInteractor(QtInteractor):
-    """A `pyvistaqt.QtInteractor` whose repaints render only when the scene changed.
+class StampedInteractor(NativeInteractor):
+    """A `NativeInteractor` whose paints render only when the scene changed.
 
     Counters (tests): ``paint_renders`` (paints that rendered), ``paint_skips``,
     ``timer_skips`` (auto-update ticks that found nothing new)."""
@@ -73,14 +70,13 @@ class StampedInteractor(QtInteractor):
             return
         super()._auto_render()
 
-    def paintGL(self):  # noqa: N802 (Qt's name)
-        if not (hasattr(self, "_in_paint") and not self._in_paint and self._unchanged()):
-            self.paint_renders += 1
-            super().paintGL()
+    def paintEvent(self, ev):  # noqa: N802 (Qt's name)
+        if self._closed:
             return
-        self.paint_skips += 1
-        self._in_paint = True          # the widget's guard: blit the last frame, do not render
-        try:
-            super().paintGL()
-        finally:
-            self._in_paint = False
+        if not self._unchanged():
+            self.paint_renders += 1
+            super().paintEvent(ev)
+            return
+        self.paint_skips += 1          # the last frame, from VTK's framebuffer: no render
+        self.render_window.MakeCurrent()
+        self.render_window.Frame()

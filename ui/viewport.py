@@ -1,6 +1,6 @@
 """3D viewport: the current solid (optionally tiled 3x3x3), its skeleton and the unit cell.
 
-A thin adapter over a pyvistaqt `QtInteractor`.  The scene is kept by actor
+A thin adapter over a native-window plotter (`ui.native_view`).  The scene is kept by actor
 (`ui.scene.SceneActors`): a new state replaces only the actors whose value
 changed, so selecting another node that shows the same solid touches
 nothing.  A solid is drawn as tiles sharing one mesh (`ui.solid_actors`) at
@@ -94,6 +94,9 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
         self._view: SolidActors | None = None           # the one in the renderer
         self.solid_prop = pv.Property(color=SOLID_COLOUR, specular=0.25, interpolation="phong")
         self.plotter.renderer.AddObserver("StartEvent", self._before_frame)
+        self.plotter.render_window.AddObserver("EndEvent", self._after_frame)
+        self._first_frame = None            # (solid, Event) set once the new solid is first drawn
+        self._shaders_warm = False          # `_warm_up_shaders` ran
         self._prep = TaskRunner(self)
         self._prep.published.connect(self._on_partial)
         self._prep.finished.connect(self._on_done)
@@ -381,7 +384,12 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
         QtCore.QTimer.singleShot(0, self._frame_when_sized)
 
     def _frame_when_sized(self) -> None:
-        if not self._closed and self._frame():
+        if self._closed:
+            return
+        framed = self._frame()
+        if self._sized() and self._warm_up_shaders():
+            framed = True                   # the speck's frames went: draw the scene again
+        if framed:
             self.request_render()
 
     # -- output -------------------------------------------------------------------------

@@ -11,13 +11,22 @@ nothing.
 
 from __future__ import annotations
 
+import threading
+
+import numpy as np
+
 from engine.geometry.values import Solid
 
 from .scene_lod import build_levels
+from .scene_prep import prepare_cell
 from .solid_actors import SolidActors
 from .view_content import tile_offsets
 
 KEPT_SOLIDS = 3       # solids whose prepared levels (and uploaded meshes) are kept for re-selection
+WARM_OPACITIES = (1.0, 0.35)   # the solid's shader variants: opaque, and faint behind its skeleton
+_TET_VERTICES = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+_TET_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int64)
+FIRST_FRAME_WAIT = 1.0   # s the decimated levels wait for the full cell's first frame (then go on anyway)
 
 
 class ViewportSolid:
@@ -46,8 +55,45 @@ class ViewportSolid:
                 self._attach(key, view)          # levels so far; the rest arrive
                 return True
             return False
-        self._prep.submit(lambda task: _prepare_levels(task, solid), data=key)
+        shown = threading.Event()
+        self._first_frame = (solid, shown)
+        self._prep.submit(lambda task: _prepare_levels(task, solid, shown), data=key)
         return False
+
+    def _warm_up_shaders(self) -> bool:
+        """Once, when the viewport is first shown and sized: draw a speck with the solid's
+        actor kind and property, opaque and translucent, so that compiling those shaders
+        (~60 ms on llvmpipe) is not added to the first solid's frame.  True if it drew."""
+        if self._shaders_warm or self._closed:
+            return False
+        self._shaders_warm = True
+        camera = self.plotter.renderer.GetActiveCamera()
+        size = 1e-3 * max(camera.GetDistance(), 1e-9)
+        speck = SolidActors(self.plotter.renderer, self.solid_prop, np.full(3, size))
+        speck.set_levels([prepare_cell(_TET_VERTICES * size, _TET_FACES)], complete=True)
+        speck.set_offsets(np.asarray(camera.GetFocalPoint(), dtype=float))   # in view, whatever the camera
+        opacity = self.solid_prop.GetOpacity()
+        cullers = self.plotter.renderer.GetCullers()
+        kept = [cullers.GetItemAsObject(i) for i in range(cullers.GetNumberOfItems())]
+        cullers.RemoveAllItems()            # a sub-pixel speck would be culled, its shaders never built
+        try:
+            for value in WARM_OPACITIES:
+                self.solid_prop.SetOpacity(value)
+                self.plotter.render()
+        finally:
+            for culler in kept:
+                cullers.AddItem(culler)
+            self.solid_prop.SetOpacity(opacity)
+            speck.release(self.plotter.render_window)
+        return True
+
+    def _after_frame(self, *_args) -> None:
+        """Render window EndEvent: a new solid's first frame is on screen, so the
+        decimation of its other levels no longer competes with drawing it."""
+        first = self._first_frame
+        if first is not None and self._view is not None and self._kept(first[0]) is self._view:
+            first[1].set()
+            self._first_frame = None
 
     def _kept(self, solid: Solid) -> SolidActors | None:
         return next((v for s, v in self._views if s is solid), None)
@@ -128,10 +174,27 @@ def same_key(a, b) -> bool:
     return a is not None and b is not None and a[0] is b[0] and a[1] == b[1]
 
 
-def _prepare_levels(task, solid: Solid):
+def _prepare_levels(task, solid: Solid, shown: threading.Event | None = None):
     """Worker thread: the levels of detail of `solid`'s cell (`ui.scene_lod.build_levels`),
-    each growing set published as it is made; returns the full set."""
+    each growing set published as it is made; returns the full set.  After the
+    full cell is published, the decimated levels wait for `shown` (its first
+    frame: decimating shares the two cores and the GIL with that frame), at most
+    `FIRST_FRAME_WAIT` seconds."""
     levels = ()
     for levels in build_levels(solid.vertices, solid.faces, check=task.check):
         task.publish(levels)
+        if shown is not None and len(levels) == 1:
+            _wait_for(shown, task)
     return levels
+
+
+def _wait_for(event: threading.Event, task, timeout: float = FIRST_FRAME_WAIT, step: float = 0.02) -> bool:
+    """Wait until `event` is set (True) or `timeout` s pass (False); `task.check()` between
+    steps, so a cancelled task stops waiting."""
+    waited = 0.0
+    while not event.wait(step):
+        task.check()
+        waited += step
+        if waited >= timeout:
+            return False
+    return True

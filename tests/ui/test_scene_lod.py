@@ -135,3 +135,59 @@ def test_tiles_follow_the_shared_property_into_translucency():
         assert view.drawn_triangles() == len(cells[0].faces)
     finally:
         plotter.close()
+
+
+class _Task:
+    """Stands in for a TaskRunner task: records publishes; `check` raises once cancelled."""
+
+    def __init__(self):
+        self.published = []
+        self.cancelled = False
+
+    def publish(self, levels):
+        self.published.append(len(levels))
+
+    def check(self):
+        if self.cancelled:
+            raise RuntimeError("cancelled")
+
+
+def _sphere_cell():
+    mesh = pv.Sphere(theta_resolution=60, phi_resolution=60).triangulate()
+    return np.asarray(mesh.points), np.asarray(mesh.regular_faces)
+
+
+def test_decimated_levels_wait_for_the_full_cells_first_frame():
+    import threading
+
+    from ui import viewport_solid
+
+    vertices, faces = _sphere_cell()
+    solid = type("SolidArrays", (), {"vertices": vertices, "faces": faces})()   # what the worker reads
+    task, shown, out = _Task(), threading.Event(), []
+    worker = threading.Thread(target=lambda: out.append(viewport_solid._prepare_levels(task, solid, shown)))
+    worker.start()
+    try:
+        worker.join(0.5)
+        assert worker.is_alive() and task.published == [1]     # the full cell only, then waiting
+    finally:
+        shown.set()                                             # the frame is on screen
+    worker.join(120)
+    assert not worker.is_alive()
+    assert task.published == list(range(1, len(level_targets(len(faces))) + 1))
+    assert len(out[0]) == len(task.published)
+
+
+def test_the_wait_for_a_first_frame_ends_on_cancel_and_on_timeout():
+    import threading
+
+    from ui.viewport_solid import _wait_for
+
+    task = _Task()
+    assert _wait_for(threading.Event(), task, timeout=0.06, step=0.02) is False   # never drawn: go on
+    ready = threading.Event()
+    ready.set()
+    assert _wait_for(ready, task) is True
+    task.cancelled = True
+    with pytest.raises(RuntimeError, match="cancelled"):
+        _wait_for(threading.Event(), task)

@@ -233,10 +233,46 @@ def test_an_unchanged_scene_is_not_rendered_again(octet, qtbot):
         assert frames == [] and widget.paint_skips > 0
         widget.camera.azimuth += 30.0           # a change nobody rendered: the auto-update draws it
         qtbot.waitUntil(lambda: len(frames) >= 1, timeout=30000)
-        vp.plotter.render()                     # an explicit render is done once, not again by the repaint
+        vp.plotter.render()                     # an explicit render is done once, not again by a repaint
         count = len(frames)
         skips = widget.paint_skips
-        qtbot.waitUntil(lambda: widget.paint_skips > skips, timeout=30000)
-        assert len(frames) == count
+        widget.repaint()
+        assert widget.paint_skips == skips + 1 and len(frames) == count
     finally:
         widget.render_window.RemoveObserver(tag)
+
+
+def test_the_rest_of_the_window_repaints_without_the_viewport(octet, qtbot):
+    """The viewport is a native window VTK draws into: the main window stays a raster
+    surface (nothing composed through OpenGL), and repainting other widgets neither
+    paints nor renders the viewport."""
+    from PySide6 import QtGui
+    assert octet.windowHandle().surfaceType() == QtGui.QSurface.SurfaceType.RasterSurface
+    widget = octet.viewport.plotter
+    assert widget.windowHandle() is not None and widget.internalWinId()   # a native child window
+    qtbot.wait(300)
+    frames = []
+    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
+    try:
+        paints = widget.paint_renders + widget.paint_skips
+        for k in range(5):
+            octet.statusBar().showMessage(f"message {k}")
+            octet.statusBar().repaint()
+            qtbot.wait(20)
+        assert widget.paint_renders + widget.paint_skips == paints and frames == []
+    finally:
+        widget.render_window.RemoveObserver(tag)
+
+
+def test_the_solid_shaders_are_built_once_before_the_first_solid(octet):
+    """The warm-up speck drew once the viewport was sized and left nothing behind:
+    no actor, the renderer's cullers back, the solid's opacity back."""
+    vp = octet.viewport
+    assert vp._shaders_warm
+    ren = vp.plotter.renderer
+    assert ren.GetCullers().GetNumberOfItems() == 1
+    view = vp.solid_view()
+    tiles = set(map(id, view.actors))
+    solid_like = [a for a in ren.GetActors() if a.GetProperty() is vp.solid_prop and id(a) not in tiles]
+    assert solid_like == [] and vp.solid_prop.GetOpacity() == 1.0
+    assert vp._warm_up_shaders() is False              # once per viewport
