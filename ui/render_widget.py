@@ -64,6 +64,10 @@ class StampedInteractor(NativeInteractor):
         return rw is not None and self._frame_stamp is not None and \
             scene_stamp(rw, self._size()) == self._frame_stamp
 
+    def frame_is_current(self) -> bool:
+        """The last frame shows the scene as it is now (nothing changed since it was rendered)."""
+        return self._unchanged()
+
     def _auto_render(self) -> None:
         if self._unchanged():
             self.timer_skips += 1

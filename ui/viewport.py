@@ -231,7 +231,8 @@ class Viewport(ViewportSolid, QtWidgets.QWidget):
     def _render_now(self) -> None:
         if self._render_pending and not self._closed:
             self._render_pending = False
-            self.plotter.render()
+            if not self.plotter.frame_is_current():     # the auto-update may have drawn it already
+                self.plotter.render()
 
     def _sync_scene(self) -> bool:
         box = self.cell_box()

@@ -276,3 +276,22 @@ def test_the_solid_shaders_are_built_once_before_the_first_solid(octet):
     solid_like = [a for a in ren.GetActors() if a.GetProperty() is vp.solid_prop and id(a) not in tiles]
     assert solid_like == [] and vp.solid_prop.GetOpacity() == 1.0
     assert vp._warm_up_shaders() is False              # once per viewport
+
+
+def test_a_requested_frame_already_drawn_by_the_auto_update_is_not_drawn_again(octet, qtbot):
+    vp = octet.viewport
+    widget = vp.plotter
+    frames = []
+    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
+    try:
+        widget.camera.azimuth += 10.0
+        vp.request_render()                 # queued for after the events being handled
+        widget._auto_render()               # the 5/s timer got there first: it draws the change
+        assert len(frames) == 1
+        qtbot.waitUntil(lambda: not vp._render_pending, timeout=10000)
+        assert len(frames) == 1             # the queued request found the frame current
+        widget.camera.azimuth += 10.0
+        vp.request_render()
+        qtbot.waitUntil(lambda: len(frames) == 2, timeout=10000)   # a change nobody drew: drawn once
+    finally:
+        widget.render_window.RemoveObserver(tag)
