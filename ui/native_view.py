@@ -27,19 +27,6 @@ from PySide6 import QtCore
 from vtkmodules.qt.QVTKRenderWindowInteractor import QVTKRenderWindowInteractor
 
 
-def native_window_id(widget) -> int:
-    """The widget's native window handle as an integer (PySide gives an int, PyQt a sip pointer or a capsule)."""
-    wid = widget.winId()
-    if type(wid).__name__ == "PyCapsule":
-        import ctypes
-        ctypes.pythonapi.PyCapsule_GetName.restype = ctypes.c_char_p
-        ctypes.pythonapi.PyCapsule_GetName.argtypes = [ctypes.py_object]
-        ctypes.pythonapi.PyCapsule_GetPointer.restype = ctypes.c_void_p
-        ctypes.pythonapi.PyCapsule_GetPointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
-        wid = ctypes.pythonapi.PyCapsule_GetPointer(wid, ctypes.pythonapi.PyCapsule_GetName(wid))
-    return int(wid)
-
-
 class _QtInitEnds:
     """Ends the Qt binding's cooperative ``__init__`` chain: `BasePlotter` is initialised explicitly, with arguments."""
 
@@ -80,7 +67,7 @@ class NativeInteractor(QVTKRenderWindowInteractor, _QtInitEnds, BasePlotter):
     # -- Qt events ---------------------------------------------------------------------
     def event(self, ev) -> bool:
         if ev.type() == QtCore.QEvent.Type.WinIdChange and getattr(self, "_RenderWindow", None) is not None:
-            self._RenderWindow.SetWindowInfo(str(native_window_id(self)))
+            self._RenderWindow.SetWindowInfo(str(int(self.winId())))   # PySide gives the id as an int
         return super().event(ev)
 
     def closeEvent(self, ev) -> None:

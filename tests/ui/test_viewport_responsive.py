@@ -9,6 +9,7 @@ camera's projection of the cell box, toolpaths after another example opens.
 
 from __future__ import annotations
 
+import contextlib
 import threading
 
 import numpy as np
@@ -24,6 +25,17 @@ from heartbeat import Heartbeat
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")  # NodeGraphQt uses distutils versions
 
 HEARTBEATS_WHILE_PREPARING = 5
+
+
+@contextlib.contextmanager
+def frames_drawn(widget):
+    """A list that gets one entry per frame the widget's render window draws inside the block."""
+    frames = []
+    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
+    try:
+        yield frames
+    finally:
+        widget.render_window.RemoveObserver(tag)
 
 
 @pytest.fixture
@@ -222,9 +234,7 @@ def test_toolpaths_go_when_another_example_opens(octet, wait_eval):
 def test_an_unchanged_scene_is_not_rendered_again(octet, qtbot):
     vp = octet.viewport
     widget = vp.plotter
-    frames = []
-    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
-    try:
+    with frames_drawn(widget) as frames:
         skips = widget.timer_skips
         qtbot.waitUntil(lambda: widget.timer_skips >= skips + 2, timeout=30000)   # the 5/s auto-update ticked
         for k in range(5):                      # repaints of the window (status text): the last frame is shown
@@ -238,8 +248,6 @@ def test_an_unchanged_scene_is_not_rendered_again(octet, qtbot):
         skips = widget.paint_skips
         widget.repaint()
         assert widget.paint_skips == skips + 1 and len(frames) == count
-    finally:
-        widget.render_window.RemoveObserver(tag)
 
 
 def test_the_rest_of_the_window_repaints_without_the_viewport(octet, qtbot):
@@ -251,17 +259,13 @@ def test_the_rest_of_the_window_repaints_without_the_viewport(octet, qtbot):
     widget = octet.viewport.plotter
     assert widget.windowHandle() is not None and widget.internalWinId()   # a native child window
     qtbot.wait(300)
-    frames = []
-    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
-    try:
+    with frames_drawn(widget) as frames:
         paints = widget.paint_renders + widget.paint_skips
         for k in range(5):
             octet.statusBar().showMessage(f"message {k}")
             octet.statusBar().repaint()
             qtbot.wait(20)
         assert widget.paint_renders + widget.paint_skips == paints and frames == []
-    finally:
-        widget.render_window.RemoveObserver(tag)
 
 
 def test_the_solid_shaders_are_built_once_before_the_first_solid(octet):
@@ -281,9 +285,7 @@ def test_the_solid_shaders_are_built_once_before_the_first_solid(octet):
 def test_a_requested_frame_already_drawn_by_the_auto_update_is_not_drawn_again(octet, qtbot):
     vp = octet.viewport
     widget = vp.plotter
-    frames = []
-    tag = widget.render_window.AddObserver("EndEvent", lambda *_: frames.append(1))
-    try:
+    with frames_drawn(widget) as frames:
         widget.camera.azimuth += 10.0
         vp.request_render()                 # queued for after the events being handled
         widget._auto_render()               # the 5/s timer got there first: it draws the change
@@ -293,5 +295,3 @@ def test_a_requested_frame_already_drawn_by_the_auto_update_is_not_drawn_again(o
         widget.camera.azimuth += 10.0
         vp.request_render()
         qtbot.waitUntil(lambda: len(frames) == 2, timeout=10000)   # a change nobody drew: drawn once
-    finally:
-        widget.render_window.RemoveObserver(tag)
