@@ -21,11 +21,13 @@ import pyvista as pv
 @dataclass(frozen=True)
 class PreparedCell:
     """One cell's mesh ready to tile: vertices (n, 3) float32 mm, faces (m, 3)
-    int64, unit point normals (n, 3) float32."""
+    int64, unit point normals (n, 3) float32; `error` (mm) the measured deviation
+    from the solid's full mesh (0 for the full mesh itself, `ui.scene_lod.surface_deviation`)."""
 
     vertices: np.ndarray
     faces: np.ndarray
     normals: np.ndarray
+    error: float = 0.0
 
 
 def point_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -45,11 +47,11 @@ def point_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return (acc / length[:, None]).astype(np.float32)
 
 
-def prepare_cell(vertices: np.ndarray, faces: np.ndarray) -> PreparedCell:
+def prepare_cell(vertices: np.ndarray, faces: np.ndarray, error: float = 0.0) -> PreparedCell:
     """The cell's arrays in the dtypes the renderer takes, with point normals."""
     v = np.ascontiguousarray(vertices, dtype=np.float32)
     f = np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3)
-    return PreparedCell(v, f, point_normals(v, f))
+    return PreparedCell(v, f, point_normals(v, f), float(error))
 
 
 def skeleton_polydata(polylines: list[np.ndarray]) -> pv.PolyData | None:

@@ -8,7 +8,8 @@ the level sets the actors' mapper, so neither uploads anything again.  All
 actors share one property (colour, opacity).
 
 Before every frame (`choose`, called from the renderer's StartEvent) the
-level is picked from the cell's size on screen and whether the camera is
+level is picked from the cell's size on screen, each level's deviation from
+the full mesh in pixels, and whether the camera is
 moving (the interactor raises the render window's desired update rate while a
 drag, wheel or key moves the camera and lowers it when it stops) and whether
 the shared property is translucent.
@@ -47,6 +48,7 @@ class SolidActors:
         self.prop = prop
         self.box = np.asarray(box, dtype=float)
         self.meshes: list[pv.PolyData] = []
+        self.errors: list[float] = []            # each level's deviation from the full mesh, mm
         self.mappers: list[vtk.vtkPolyDataMapper] = []
         self.actors: list[vtk.vtkActor] = []
         self.offsets = np.zeros((0, 3))
@@ -67,6 +69,7 @@ class SolidActors:
             mapper.SetInputData(mesh)
             mapper.ScalarVisibilityOff()
             self.meshes.append(mesh)
+            self.errors.append(float(cell.error))
             self.mappers.append(mapper)
         self.complete = complete
 
@@ -99,13 +102,16 @@ class SolidActors:
             mapper.ReleaseGraphicsResources(window)
 
     # -- per frame ------------------------------------------------------------------------
-    def cell_pixels(self) -> float:
-        """The cell's longest edge on screen (pixels) at the camera's focal distance."""
+    def pixels_per_mm(self) -> float:
+        """Screen pixels per mm at the camera's focal distance."""
         cam = self.renderer.GetActiveCamera()
         height = max(1, self.renderer.GetSize()[1])
-        ppm = pixels_per_mm(height, cam.GetDistance(), cam.GetViewAngle(),
-                            bool(cam.GetParallelProjection()), cam.GetParallelScale())
-        return float(self.box.max()) * ppm
+        return pixels_per_mm(height, cam.GetDistance(), cam.GetViewAngle(),
+                             bool(cam.GetParallelProjection()), cam.GetParallelScale())
+
+    def cell_pixels(self) -> float:
+        """The cell's longest edge on screen (pixels) at the camera's focal distance."""
+        return float(self.box.max()) * self.pixels_per_mm()
 
     def choose(self, moving: bool | None = None) -> None:
         """Put every tile on the level for this frame (no upload if it was drawn before)."""
@@ -116,8 +122,10 @@ class SolidActors:
             moving = window is not None and window.GetDesiredUpdateRate() >= MOVING_RATE
         counts = [m.n_cells for m in self.meshes]
         self.in_view = self.copies_in_view()
-        level, fits = pick_level(counts, max(1, self.in_view), self.cell_pixels(), moving,
-                                 translucent=self.prop.GetOpacity() < 1.0)
+        ppm = self.pixels_per_mm()
+        level, fits = pick_level(counts, max(1, self.in_view), float(self.box.max()) * ppm, moving,
+                                 translucent=self.prop.GetOpacity() < 1.0,
+                                 error_pixels=[e * ppm for e in self.errors])
         self.last_moving, self.last_level = moving, counts[level]
         # a tiling no level fits yet (the coarse levels are being made): only the middle tile
         self.partial = not fits and not self.complete and len(self.offsets) > 1

@@ -2,7 +2,8 @@
 
 A mixin of `ui.viewport.Viewport`.  A new solid's levels (`ui.scene_lod.build_levels`:
 the full cell with normals, then decimated cells) are made in the viewport's
-`TaskRunner`; each growing set is drawn as it arrives, and the solid counts as
+`TaskRunner` (a large cell's first set holds its full mesh and the level a
+still single cell draws); each growing set is drawn as it arrives, and the solid counts as
 shown (`is_ready`) once every level is in.  The levels and their uploaded
 meshes (`ui.solid_actors.SolidActors`) are kept for the last `KEPT_SOLIDS`
 solids, so re-selecting a solid or switching the tiling prepares and uploads
@@ -26,7 +27,7 @@ KEPT_SOLIDS = 3       # solids whose prepared levels (and uploaded meshes) are k
 WARM_OPACITIES = (1.0, 0.35)   # the solid's shader variants: opaque, and faint behind its skeleton
 _TET_VERTICES = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
 _TET_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int64)
-FIRST_FRAME_WAIT = 1.0   # s the decimated levels wait for the full cell's first frame (then go on anyway)
+FIRST_FRAME_WAIT = 1.0   # s the coarser levels wait for a new solid's first frame (then go on anyway)
 
 
 class ViewportSolid:
@@ -177,13 +178,13 @@ def same_key(a, b) -> bool:
 def _prepare_levels(task, solid: Solid, shown: threading.Event | None = None):
     """Worker thread: the levels of detail of `solid`'s cell (`ui.scene_lod.build_levels`),
     each growing set published as it is made; returns the full set.  After the
-    full cell is published, the decimated levels wait for `shown` (its first
+    first set is published, the coarser levels wait for `shown` (its first
     frame: decimating shares the two cores and the GIL with that frame), at most
     `FIRST_FRAME_WAIT` seconds."""
     levels = ()
-    for levels in build_levels(solid.vertices, solid.faces, check=task.check):
+    for k, levels in enumerate(build_levels(solid.vertices, solid.faces, check=task.check)):
         task.publish(levels)
-        if shown is not None and len(levels) == 1:
+        if shown is not None and k == 0:
             _wait_for(shown, task)
     return levels
 

@@ -19,7 +19,7 @@ from .box_cell import check_cell
 from .slab_marching import slab_marching_cubes
 from engine.progress import report
 
-__all__ = ["periodic_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
+__all__ = ["periodic_mesh", "box_mesh", "drop_specks", "boundary_section_match", "solid_volume_fraction",
            "mesh_volume_fraction", "mesh_volume"]
 
 
@@ -95,6 +95,47 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None
         raise ValueError(f"cell_size must be a finite length > 0; got {cell_size!r}")
     box = np.array(check_cell(cell), dtype=np.float64)
 
+    spacing = cs * box / np.array(f.shape, dtype=np.float64)
+    extent = cs * box * np.array(t, dtype=np.float64)
+    axes = [np.arange(f.shape[a] * t[a] + 1) % f.shape[a] for a in range(3)]
+    return _mesh_grid(f, axes, lv, spacing, extent, closed, progress)
+
+
+def box_mesh(samples, *, spacing, level=0.0, progress=None):
+    """The solid ``samples < level`` of a box that is not a periodic cell, capped where it
+    meets the box (watertight).
+
+    Parameters
+    ----------
+    samples : (n0, n1, n2) float, n_i >= 2
+        Node samples ``[x, y, z]`` at ``i * spacing`` (both box faces included).
+    spacing : (3,) float > 0
+        Node spacing per axis, model units (mm).
+    level, progress : as in `periodic_mesh`.
+
+    Returns
+    -------
+    vertices (v, 3) float64 in ``[0, (n - 1) * spacing]``, faces (f, 3) int64,
+    outward; empty arrays if nothing lies inside.
+
+    Raises
+    ------
+    ValueError
+        For a grid that is not 3-D with two samples per axis, NaN samples or a
+        spacing that is not three lengths > 0.
+    """
+    f = _check_field(samples)
+    lv = _check_level(level)
+    h = np.asarray(spacing, dtype=np.float64).reshape(-1)
+    if h.shape != (3,) or not np.all(np.isfinite(h)) or np.any(h <= 0):
+        raise ValueError(f"spacing must be three lengths > 0; got {spacing!r}")
+    extent = h * (np.array(f.shape, dtype=np.float64) - 1)
+    return _mesh_grid(f, [np.arange(n) for n in f.shape], lv, h, extent, True, progress)
+
+
+def _mesh_grid(f, axes, lv, spacing, extent, closed, progress):
+    """Marching cubes of ``f[np.ix_(*axes)]`` (node spacing `spacing`), capped on the box
+    ``[0, extent]`` if `closed`."""
     # scikit-image works in float32; do the nudging there so it survives.
     f = f.astype(np.float32)
     lv32 = np.float32(lv)
@@ -105,16 +146,13 @@ def periodic_mesh(field, *, level=0.0, tiles=(1, 1, 1), cell_size=1.0, cell=None
     if not ((f < lv32).any() and ((f > lv32).any() or closed)):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
 
-    # Tile and append the wrap sample in one gather; with ``closed`` the
-    # grid gets a layer of clearly-outside samples all round, whose
-    # crossings are clipped back onto the box faces below.
+    # Gather the grid (a tiled cell appends the wrap sample); with ``closed``
+    # it gets a layer of clearly-outside samples all round, whose crossings
+    # are clipped back onto the box faces below.
     pad = 1 if closed else 0
-    axes = [np.arange(f.shape[a] * t[a] + 1) % f.shape[a] for a in range(3)]
     grid = tiled_grid(f, axes, pad, lv32 + np.float32(10.0 * (spread + 1.0)))
 
     verts, faces = slab_marching_cubes(grid, float(lv32), progress)
-    spacing = cs * box / np.array(f.shape, dtype=np.float64)
-    extent = cs * box * np.array(t, dtype=np.float64)
     verts = (verts.astype(np.float64) - pad) * spacing
     faces = faces.astype(np.int64)
     if closed:

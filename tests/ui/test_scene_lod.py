@@ -13,23 +13,79 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from ui.scene_lod import (MOVING_BUDGET, STILL_BUDGET, TRIANGLES_PER_PIXEL, build_levels, level_targets,
-                          pick_level, pixels_per_mm)
+from ui.scene_lod import (MOVING_BUDGET, SINGLE_FRAME_BUDGET, STILL_BUDGET, STILL_ERROR_PIXELS,
+                          TRIANGLES_PER_PIXEL, build_levels, decimated, level_targets, pick_level, pixels_per_mm,
+                          surface_deviation)
+from ui.scene_prep import prepare_cell
 
-LEVELS = [123_248, 4_444, 1_481, 40_000, 15_000]       # the octet cell's ladder (build order)
+LEVELS = [123_248, 40_000, 15_000, 4_444, 1_481]       # the octet cell's ladder (build order)
 
 
 def test_ladder_targets_what_each_view_can_afford():
     assert level_targets(123_248) == LEVELS
     assert level_targets(5_000) == [5_000, 1_481]              # 4 444 is not clearly coarser than 5 000
     assert level_targets(300) == [300]                         # too small to decimate
-    targets = level_targets(2_000_000)
-    assert targets[0] == 2_000_000 and sorted(targets[1:], reverse=True) == [40_000, 15_000, 4_444, 1_481]
+    assert level_targets(2_000_000) == [2_000_000, 40_000, 15_000, 4_444, 1_481]
 
 
-def test_a_still_single_cell_is_drawn_in_full():
-    for pixels in (50, 300, 2000):
+def test_a_still_single_cell_draws_the_coarsest_level_no_pixel_can_tell_apart():
+    for pixels in (50, 300, 2000):                             # deviations unknown: the full mesh
         assert pick_level(LEVELS, 1, pixels, moving=False) == (0, True)
+    errors_mm = [0.0, 0.0004, 0.001, 0.004, 0.01]              # each level's deviation from the full mesh
+    for ppm, want in ((100.0, 3), (1000.0, 1), (3000.0, 0), (30.0, 4)):
+        i, fits = pick_level(LEVELS, 1, ppm, moving=False, error_pixels=[e * ppm for e in errors_mm])
+        assert fits and i == want                              # the coarsest under half a pixel
+        assert errors_mm[i] * ppm < STILL_ERROR_PIXELS
+        assert all(errors_mm[j] * ppm >= STILL_ERROR_PIXELS for j in range(len(LEVELS)) if LEVELS[j] < LEVELS[i])
+    # the deviations do not loosen the tiled or moving rules
+    tiled = pick_level(LEVELS, 27, 170, moving=False, error_pixels=[e * 170 for e in errors_mm])
+    assert tiled == pick_level(LEVELS, 27, 170, moving=False)
+
+
+def _brute_deviation(a, b) -> float:
+    """Largest distance from a vertex of either mesh to the other's triangles, by projecting each
+    vertex on every triangle (plane, edges, corners) with numpy: slow and plain."""
+    def point_triangle(p, tri):                     # (n, 3) points, (m, 3, 3) triangles -> (n,) min distance
+        best = np.full(len(p), np.inf)
+        a0, b0, c0 = tri[:, 0], tri[:, 1], tri[:, 2]
+        n = np.cross(b0 - a0, c0 - a0)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        for k in range(len(p)):
+            q = p[k]
+            d = np.einsum("ij,ij->i", q - a0, n)
+            foot = q - d[:, None] * n
+            inside = np.ones(len(tri), bool)        # the foot is inside if on the inner side of every edge
+            for u, v in ((a0, b0), (b0, c0), (c0, a0)):
+                inside &= np.einsum("ij,ij->i", np.cross(v - u, foot - u), n) >= 0
+            cand = [np.where(inside, np.abs(d), np.inf)]
+            for u, v in ((a0, b0), (b0, c0), (c0, a0)):
+                t = np.clip(np.einsum("ij,ij->i", q - u, v - u) / np.einsum("ij,ij->i", v - u, v - u), 0, 1)
+                cand.append(np.linalg.norm(q - (u + t[:, None] * (v - u)), axis=1))
+            best[k] = np.min(cand)
+        return best.max()
+    va, vb = np.asarray(a.vertices, float), np.asarray(b.vertices, float)
+    return max(point_triangle(va, vb[b.faces]), point_triangle(vb, va[a.faces]))
+
+
+def test_the_measured_deviation_of_a_level_is_the_brute_force_one():
+    sphere = pv.Sphere(radius=1.0, theta_resolution=24, phi_resolution=24).triangulate()
+    full = prepare_cell(np.asarray(sphere.points), np.asarray(sphere.regular_faces))
+    coarse = decimated(full, 700)
+    for level in (coarse, decimated(coarse, 400, reference=full)):
+        assert len(level.faces) < len(full.faces)
+        assert level.error == pytest.approx(_brute_deviation(full, level), rel=1e-4, abs=1e-6)
+        assert level.error > 0
+    squashed = prepare_cell(full.vertices * np.array([1.0, 1.0, 0.9], np.float32), full.faces)
+    assert surface_deviation(full, squashed) == pytest.approx(_brute_deviation(full, squashed), rel=1e-4)
+
+
+def test_a_large_cell_is_first_published_with_its_still_level():
+    sphere = pv.Sphere(radius=1.0, theta_resolution=200, phi_resolution=200).triangulate()
+    faces = np.asarray(sphere.regular_faces)
+    assert len(faces) > SINGLE_FRAME_BUDGET
+    first = next(build_levels(np.asarray(sphere.points), faces))
+    assert [len(c.faces) for c in first][0] == len(faces) and len(first) == 2
+    assert len(first[1].faces) <= 1.1 * MOVING_BUDGET and first[1].error > 0
 
 
 def test_moving_views_keep_to_the_moving_budget():
@@ -123,16 +179,25 @@ def test_tiles_follow_the_shared_property_into_translucency():
         view = SolidActors(plotter.renderer, prop, np.ones(3))
         view.set_levels(cells, complete=True)
         view.set_offsets(np.zeros((1, 3)))
-        plotter.camera.focal_point, plotter.camera.position = (0.5, 0.5, 0.5), (0.5, 0.5, 4.0)
-        view.choose(moving=False)
-        assert view.drawn_triangles() == len(cells[0].faces) > MOVING_BUDGET      # opaque: the full mesh
-        prop.SetOpacity(0.35)
-        view.choose(moving=False)
-        assert view.drawn_triangles() <= MOVING_BUDGET
-        assert view.drawn_triangles() == max(len(c.faces) for c in cells if len(c.faces) <= MOVING_BUDGET)
-        prop.SetOpacity(1.0)
-        view.choose(moving=False)
-        assert view.drawn_triangles() == len(cells[0].faces)
+        finest = min(c.error for c in cells[1:])
+        for distance in (1.0, 0.2 * finest * 400 / (2 * np.tan(np.radians(15.0)))):   # framed, then close
+            plotter.camera.focal_point = (0.5, 0.5, 0.5)
+            plotter.camera.position = (0.5, 0.5, 0.5 + distance)
+            plotter.camera.view_angle = 30.0
+            plotter.render()
+            ppm = 400 / (2 * distance * np.tan(np.radians(15.0)))   # pixels per mm at the focal point
+            opaque = min(len(c.faces) for c in cells if c.error * ppm < STILL_ERROR_PIXELS)
+            prop.SetOpacity(1.0)
+            view.choose(moving=False)
+            assert view.drawn_triangles() == opaque
+            prop.SetOpacity(0.35)
+            view.choose(moving=False)
+            assert view.drawn_triangles() == max(len(c.faces) for c in cells
+                                                 if len(c.faces) <= min(MOVING_BUDGET, opaque))
+            prop.SetOpacity(1.0)
+            view.choose(moving=False)
+            assert view.drawn_triangles() == opaque
+        assert opaque == len(cells[0].faces) > MOVING_BUDGET       # close: the full mesh, unless translucent
     finally:
         plotter.close()
 
