@@ -12,6 +12,7 @@ FAMILY_COLOURS = {
     "transform": (150, 110, 200),
     "solid": (90, 180, 110),
     "property": (60, 165, 175),     # teal: apart from the red of a failed node's outline
+    "implicit": (200, 120, 70),     # implicit media (SDF values)
 }
 
 # Port dot colours by value type, so compatible ends are recognisable at a glance.
@@ -27,6 +28,7 @@ PORT_COLOURS = {
     "Mesh": (160, 220, 220),
     "TileSet": (180, 140, 240),
     "Tiling": (140, 120, 220),
+    "SDF": (230, 140, 80),
 }
 
 # Text colour of a node's evaluation status (inspector, docks).

@@ -14,4 +14,5 @@ register_port_types("Point", "EdgeChain", "Skeleton", "Solid", "Voxel", "Field",
                     "TileSet", "Tiling",                                               # growth
                     "PhasorFields", "PhasorInfill", "Energy",                          # phasor
                     "Design",                                                          # topopt
-                    "RDFields", "RDStructures", "Contour")                             # rd
+                    "RDFields", "RDStructures", "Contour",                             # rd
+                    "SDF")                                                             # implicit

@@ -1,0 +1,376 @@
+"""Suspended particle clouds (paper 004, section 3.1): one particle per cell of a cubic grid.
+
+Space is cut into cubic cells of width w (mm); cell c = (i, j, k) covers
+``[c w, (c + 1) w]``.  Each cell draws uniforms u_0 .. u_8 from the hash of
+its index and the seed (`cell_hash`), the same numbers in numpy and GLSL:
+
+* u_0: Russian roulette, the particle exists iff ``u_0 < density`` (density
+  taken at the cell centre, constant or a linear ramp along an axis);
+* u_1, u_2: the size s (mm) from a `SizeDistribution`, clamped to
+  ``[0, s_max]`` where ``s_max * bound = w / 2`` (bound: the unit shape's
+  bounding radius); a size of 0 gives no particle;
+* u_3 .. u_5: the centre ``w (c + 0.5 + jitter (u - 0.5) (1 - 2 r_b / w))``
+  with r_b = s * bound, so the bounding sphere stays inside the cell;
+* u_6 .. u_8: an optional uniformly random rotation (Shoemake's quaternion).
+
+The particle is the unit shape (`shapes.SHAPES`, parameters `proportions`)
+scaled by s and rotated.  A point x (after the optional warp
+``x = p + a sin(f p.yzx)``) lies in one cell of the dual grid (offset by
+w / 2); its 2 x 2 x 2 block of nearest cells, from ``floor(x / w - 0.5)``,
+are the only ones whose particles can reach it (eq. 4).  The field is
+
+    f(x) = min( min over the block's particles of d_i(x),  b(x) ) - offset,
+
+with b(x) the distance from x to the outside of the block, at least w / 2.
+Why b: every particle outside the block lies in its own cell, outside the
+block, so it is at least b(x) away; hence min(g, b) <= the distance to the
+union of all particles (a lower bound, exact wherever that distance is at
+most w / 2 and inside particles), it stays finite where the block's cells
+are empty, and it is continuous across dual-cell faces (there b = w / 2 and
+the particles that leave or enter the block are at least w / 2 away).  A
+min of 1-Lipschitz functions, it is 1-Lipschitz; the warp multiplies the
+bound by ``1 + a f``.  The offset must stay below w / 2 so that b - offset
+never creates material away from the particles.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field as dc_field
+from typing import NamedTuple
+
+import numpy as np
+
+from . import cell_hash
+from .shapes import check_shape_params, shape_glsl, shape_spec
+from .values import SDF, as_points, glsl_float
+
+__all__ = ["SizeDistribution", "Suspension", "Particles", "shoemake_rotation", "MAX_BOX_CELLS"]
+
+MAX_BOX_CELLS = 4_000_000           # cells `particles_in_box` visits at most
+_TWO_PI = 2.0 * math.pi
+_PARAMS = {"fixed": ("size",), "uniform": ("lo", "hi"), "normal": ("mean", "sd"),
+           "lognormal": ("mu", "sigma")}
+
+
+@dataclass(frozen=True)
+class SizeDistribution:
+    """The distribution of a particle's size s (mm; the scale of the unit shape).
+
+    kind : "fixed" (a = size), "uniform" (a = lo, b = hi), "normal" (a = mean,
+        b = sd; Box-Muller from two uniforms) or "lognormal" (s = exp(a + b z)
+        with z standard normal: a = mu, the log of the median in mm, b = sigma).
+
+    Raises
+    ------
+    ValueError
+        On an unknown kind or a parameter out of range (sizes > 0, lo <= hi,
+        sd and sigma >= 0, all finite).
+    """
+
+    kind: str = "fixed"
+    a: float = 0.3
+    b: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in _PARAMS:
+            raise ValueError(f"size distribution kind must be one of {sorted(_PARAMS)}, got {self.kind!r}")
+        a, b = float(self.a), float(self.b)
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise ValueError(f"size distribution parameters must be finite, got a={a!r}, b={b!r}")
+        object.__setattr__(self, "a", a)
+        object.__setattr__(self, "b", b)
+        names = _PARAMS[self.kind]
+        if self.kind != "lognormal" and not a > 0:
+            raise ValueError(f"size distribution {names[0]} must be > 0 mm, got {a!r}")
+        if self.kind == "uniform" and not b >= a:
+            raise ValueError(f"size distribution hi must be >= lo = {a!r} mm, got {b!r}")
+        if self.kind in ("normal", "lognormal") and not b >= 0:
+            raise ValueError(f"size distribution {names[1]} must be >= 0, got {b!r}")
+
+    def nominal(self) -> tuple[str, float]:
+        """(name, size in mm) of the parameter that must fit in the cell: the fixed size,
+        hi, the mean, or the median exp(mu)."""
+        if self.kind == "lognormal":
+            return "mu", math.exp(self.a)
+        return _PARAMS[self.kind][-1 if self.kind == "uniform" else 0], float(
+            self.b if self.kind == "uniform" else self.a)
+
+    def sample(self, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+        """Sizes (mm, float64, unclamped) from uniforms u1, u2 in [0, 1)."""
+        a, b = float(self.a), float(self.b)
+        if self.kind == "fixed":
+            return np.full(np.shape(u1), a)
+        if self.kind == "uniform":
+            return a + (b - a) * u1
+        z = np.sqrt(-2.0 * np.log(1.0 - u1)) * np.cos(_TWO_PI * u2)
+        return a + b * z if self.kind == "normal" else np.exp(a + b * z)
+
+    def glsl(self, u1: str, u2: str) -> str:
+        """A GLSL float expression of the size from uniforms named `u1`, `u2`."""
+        a, b = glsl_float(self.a), glsl_float(self.b)
+        if self.kind == "fixed":
+            return a
+        if self.kind == "uniform":
+            return f"({a} + {glsl_float(self.b - self.a)} * {u1})"
+        z = f"(sqrt(-2.0 * log(1.0 - {u1})) * cos({glsl_float(_TWO_PI)} * {u2}))"
+        return f"({a} + {b} * {z})" if self.kind == "normal" else f"exp({a} + {b} * {z})"
+
+
+def shoemake_rotation(u1, u2, u3) -> np.ndarray:
+    """Uniformly random rotations from uniforms ((n,) each, [0, 1)): (n, 3, 3) float64.
+
+    The unit quaternion (x, y, z, w) = (sqrt(1-u1) sin 2pi u2, sqrt(1-u1) cos 2pi u2,
+    sqrt(u1) sin 2pi u3, sqrt(u1) cos 2pi u3) is uniform on S^3 (Shoemake 1992)."""
+    a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
+    x, y = a * np.sin(_TWO_PI * u2), a * np.cos(_TWO_PI * u2)
+    z, w = b * np.sin(_TWO_PI * u3), b * np.cos(_TWO_PI * u3)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
+    ], axis=-2)
+
+
+_SHOEMAKE_GLSL = f"""mat3 mf_shoemake(float u1, float u2, float u3) {{
+    float a = sqrt(1.0 - u1);
+    float b = sqrt(u1);
+    float x = a * sin({glsl_float(_TWO_PI)} * u2);
+    float y = a * cos({glsl_float(_TWO_PI)} * u2);
+    float z = b * sin({glsl_float(_TWO_PI)} * u3);
+    float w = b * cos({glsl_float(_TWO_PI)} * u3);
+    return mat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + z * w), 2.0 * (x * z - y * w),
+                2.0 * (x * y - z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + x * w),
+                2.0 * (x * z + y * w), 2.0 * (y * z - x * w), 1.0 - 2.0 * (x * x + y * y));
+}}"""
+
+
+class Particles(NamedTuple):
+    """The particles of a set of cells (kept ones only).
+
+    cells : (m, 3) int64; centres : (m, 3) float64 mm; sizes : (m,) float64 mm;
+    rotations : (m, 3, 3) float64 (local -> world; identity without orientation);
+    radii : (m,) float64 mm, bounding radii."""
+
+    cells: np.ndarray
+    centres: np.ndarray
+    sizes: np.ndarray
+    rotations: np.ndarray
+    radii: np.ndarray
+
+
+def _finite(name, v, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False):
+    v = float(v)
+    ok = math.isfinite(v) and (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+    if not ok:
+        rng = f"{'(' if lo_open else '['}{lo!r}, {hi!r}{')' if hi_open else ']'}"
+        raise ValueError(f"{name} must be a finite number in {rng}, got {v!r}")
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class Suspension(SDF):
+    """A cloud of non-touching particles, one per grid cell (see the module docstring).
+
+    Parameters
+    ----------
+    cell : float, mm (> 0), the grid cell width w.
+    shape : str, a key of `shapes.SHAPES`; proportions : its parameters at size 1
+        (empty: the shape's default).
+    size : SizeDistribution (mm); its nominal size must fit the cell.
+    jitter : float in [0, 1], 0 puts every particle at its cell centre (a lattice).
+    orient : bool, random particle rotations.
+    density : float in [0, 1], the probability a cell holds a particle; with
+        `density_end` (in [0, 1]) it ramps linearly from `density` at coordinate
+        ``density_span[0]`` to `density_end` at ``density_span[1]`` (mm, start < end)
+        along axis `density_axis` (0, 1, 2), constant beyond.
+    offset : float, mm (< w / 2), moves every surface outwards.
+    warp_amplitude : float, mm (>= 0); warp_frequency : float, rad / mm (>= 0).
+    seed : int.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter and its allowed range (the size parameter with the
+        largest size the cell allows).
+    """
+
+    cell: float = 1.0
+    shape: str = "sphere"
+    proportions: tuple = ()
+    size: SizeDistribution = dc_field(default_factory=SizeDistribution)
+    jitter: float = 1.0
+    orient: bool = False
+    density: float = 1.0
+    density_end: float | None = None
+    density_axis: int = 2
+    density_span: tuple = (0.0, 1.0)
+    offset: float = 0.0
+    warp_amplitude: float = 0.0
+    warp_frequency: float = 0.0
+    seed: int = 0
+
+    def __post_init__(self):
+        w = _finite("cell width", self.cell, 0.0, lo_open=True)
+        props = check_shape_params(self.shape, self.proportions)
+        if not isinstance(self.size, SizeDistribution):
+            raise ValueError(f"size must be a SizeDistribution, got {type(self.size).__name__}")
+        bound = float(shape_spec(self.shape).bound(*props))
+        smax = 0.5 * w / bound
+        name, nominal = self.size.nominal()
+        if nominal > smax:
+            if name == "mu":
+                given, allowed = self.size.a, f"{math.log(smax)!r} (a median of {smax!r} mm)"
+            else:
+                given, allowed = nominal, f"{smax!r} mm"
+            raise ValueError(f"size distribution parameter {name} = {given!r} is too large for cell "
+                             f"width {w!r} mm: at most {allowed}, so that the bounding radius "
+                             f"stays <= w / 2")
+        object.__setattr__(self, "jitter", _finite("jitter", self.jitter, 0.0, 1.0))
+        if not isinstance(self.orient, (bool, np.bool_)):
+            raise ValueError(f"orient must be a bool, got {self.orient!r}")
+        object.__setattr__(self, "density", _finite("density", self.density, 0.0, 1.0))
+        if self.density_end is not None:
+            object.__setattr__(self, "density_end", _finite("density_end", self.density_end, 0.0, 1.0))
+            if self.density_axis not in (0, 1, 2):
+                raise ValueError(f"density_axis must be 0, 1 or 2, got {self.density_axis!r}")
+            span = np.asarray(self.density_span, dtype=np.float64).reshape(-1)
+            if not (span.shape == (2,) and np.all(np.isfinite(span)) and span[0] < span[1]):
+                raise ValueError(f"density_span must be finite (start, end) mm with start < end, "
+                                 f"got {self.density_span!r}")
+            object.__setattr__(self, "density_span", (float(span[0]), float(span[1])))
+        for k, hi, hi_open, lo in (("offset", 0.5 * w, True, -math.inf),
+                                   ("warp_amplitude", math.inf, False, 0.0),
+                                   ("warp_frequency", math.inf, False, 0.0)):
+            object.__setattr__(self, k, _finite(k, getattr(self, k), lo, hi, hi_open=hi_open))
+        word = cell_hash.seed_word(self.seed)
+        for k, v in (("cell", w), ("proportions", props), ("_bound", bound), ("_smax", smax),
+                     ("_word", word)):
+            object.__setattr__(self, k, v)
+
+    @property
+    def lipschitz(self):
+        return shape_spec(self.shape).lipschitz * (1.0 + self.warp_amplitude * self.warp_frequency)
+
+    # -- the particles of given cells -------------------------------------------------
+
+    def _density_of(self, cells: np.ndarray):
+        if self.density_end is None:
+            return float(self.density)
+        s0, s1 = (float(v) for v in self.density_span)
+        t = np.clip(((cells[:, self.density_axis] + 0.5) * self.cell - s0) / (s1 - s0), 0.0, 1.0)
+        return self.density * (1.0 - t) + self.density_end * t
+
+    def _particles(self, cells: np.ndarray):
+        """keep (m,) bool, sizes (m,), centres (m, 3), rotations (m, 3, 3) or None."""
+        stream = cell_hash.cell_stream(cells[:, 0], cells[:, 1], cells[:, 2], self._word)
+
+        def u(r):
+            return cell_hash.cell_uniform(stream, r)
+        s = np.clip(self.size.sample(u(1), u(2)), 0.0, self._smax)
+        keep = (u(0) < self._density_of(cells)) & (s > 0.0)
+        jit = np.stack([u(3), u(4), u(5)], axis=1)
+        shrink = 1.0 - 2.0 * s * self._bound / self.cell
+        centres = self.cell * (cells + 0.5 + self.jitter * (jit - 0.5) * shrink[:, None])
+        rot = shoemake_rotation(u(6), u(7), u(8)) if self.orient else None
+        return keep, s, centres, rot
+
+    def particles_in_box(self, lo, hi) -> Particles:
+        """Every kept particle whose cell meets the box [lo, hi] (mm, in the particles'
+        frame: the warped coordinates x when there is a warp).
+
+        Raises
+        ------
+        ValueError
+            If lo > hi on an axis, or the box spans more than `MAX_BOX_CELLS` cells.
+        """
+        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+        if lo.shape != (3,) or hi.shape != (3,) or not np.all(lo <= hi):
+            raise ValueError(f"box must be two (3,) corners with lo <= hi, got {lo!r}, {hi!r}")
+        c0 = np.floor(lo / self.cell).astype(np.int64)
+        c1 = np.floor(hi / self.cell).astype(np.int64)
+        count = int(np.prod(c1 - c0 + 1))
+        if count > MAX_BOX_CELLS:
+            raise ValueError(f"box spans {count} cells, at most {MAX_BOX_CELLS}")
+        axes = [np.arange(a, b + 1) for a, b in zip(c0, c1)]
+        cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+        keep, s, centres, rot = self._particles(cells)
+        if rot is None:
+            rot = np.broadcast_to(np.eye(3), (len(cells), 3, 3))
+        return Particles(cells[keep], centres[keep], s[keep], np.array(rot[keep]),
+                         s[keep] * self._bound)
+
+    # -- evaluation -------------------------------------------------------------------
+
+    def warp(self, points) -> np.ndarray:
+        """The particles' frame of world points: x = p + a sin(f p.yzx), (n, 3) mm."""
+        p = as_points(points)
+        if self.warp_amplitude == 0.0:
+            return p
+        return p + self.warp_amplitude * np.sin(self.warp_frequency * p[:, [1, 2, 0]])
+
+    def field(self, points):
+        x = self.warp(points)
+        spec = shape_spec(self.shape)
+        g = x / self.cell
+        base = np.floor(g - 0.5)
+        t = g - base
+        best = self.cell * np.min(np.minimum(t, 2.0 - t), axis=1)
+        base = base.astype(np.int64)
+        for corner in range(8):
+            cells = base + np.array([corner & 1, (corner >> 1) & 1, (corner >> 2) & 1])
+            keep, s, centres, rot = self._particles(cells)
+            q = x - centres
+            if rot is not None:
+                q = np.einsum("ni,nij->nj", q, rot)
+            s = np.where(keep, s, 1.0)
+            d = spec.fn(q, *(s * v for v in self.proportions))
+            best = np.minimum(best, np.where(keep, d, np.inf))
+        return best - self.offset
+
+    def glsl(self, module):
+        cell_hash.add_glsl(module)
+        helper = shape_glsl(module, self.shape)
+        if self.orient:
+            module.helper("mf_shoemake", _SHOEMAKE_GLSL)
+        w = glsl_float(self.cell)
+        args = ", ".join(f"s * {glsl_float(v)}" for v in self.proportions)
+        if self.density_end is None:
+            dens = glsl_float(self.density)
+        else:
+            s0, s1 = (float(v) for v in self.density_span)
+            ax = "xyz"[self.density_axis]
+            dens = (f"mix({glsl_float(self.density)}, {glsl_float(self.density_end)}, clamp(("
+                    f"(float(cell.{ax}) + 0.5) * {w} - {glsl_float(s0)}) / {glsl_float(s1 - s0)}, 0.0, 1.0))")
+        x = "p"
+        if self.warp_amplitude != 0.0:
+            x = (f"p + {glsl_float(self.warp_amplitude)} * "
+                 f"sin({glsl_float(self.warp_frequency)} * p.yzx)")
+        def u(r):
+            return f"mf_cell_uniform(st, {r}u)"
+        rotate = f"q = q * mf_shoemake({u(6)}, {u(7)}, {u(8)});" if self.orient else ""
+        size = self.size.glsl(u(1), u(2))
+
+        def make(n):
+            return f"""float {n}(vec3 p) {{
+    vec3 x = {x};
+    vec3 g = x / {w};
+    vec3 base = floor(g - 0.5);
+    vec3 t = g - base;
+    vec3 e = min(t, 2.0 - t);
+    float best = {w} * min(min(e.x, e.y), e.z);
+    ivec3 ib = ivec3(base);
+    for (int c = 0; c < 8; ++c) {{
+        ivec3 cell = ib + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        uint st = mf_cell_stream(cell, {self._word}u);
+        float s = clamp({size}, 0.0, {glsl_float(self._smax)});
+        if (!({u(0)} < {dens}) || !(s > 0.0)) continue;
+        vec3 jit = vec3({u(3)}, {u(4)}, {u(5)});
+        float shrink = 1.0 - 2.0 * s * {glsl_float(self._bound)} / {w};
+        vec3 q = x - {w} * (vec3(cell) + 0.5 + {glsl_float(self.jitter)} * (jit - 0.5) * shrink);
+        {rotate}
+        best = min(best, {helper}(q, {args}));
+    }}
+    return best - {glsl_float(self.offset)};
+}}"""
+        return module.function(self, make)

@@ -1,0 +1,145 @@
+"""The implicit-media nodes end to end: graphs from SDF nodes to Solids, the Material Matrix
+and CSG with unit cells, checked against closed forms and the kernels' own particle lists;
+refusals located at the parameter."""
+
+import math
+
+import numpy as np
+import pytest
+
+from engine.geometry.marching import mesh_volume
+from engine.graph import AddNode, Connect, Evaluator, GraphDocument, SetParam, UndoStack
+from engine.graph.project import document_from_dict, document_to_dict
+from engine.implicit.particles import Suspension
+
+
+def _graph():
+    doc = GraphDocument()
+    return doc, UndoStack(doc)
+
+
+def _solid(st, source, node_id="solid", **params):
+    params.setdefault("backend", "numpy")
+    st.push(AddNode("SDFSolid", params, node_id=node_id))
+    st.push(Connect(source, "sdf", node_id, "sdf"))
+
+
+def test_a_periodic_function_cell_hits_its_volume_fraction_and_homogenises():
+    doc, st = _graph()
+    st.push(AddNode("PeriodicFunction", {"kind": "schwarz_p", "cell": 2.0, "level_by": "volume fraction",
+                                         "volume_fraction": 0.3}, node_id="p"))
+    _solid(st, "p", resolution=40, fit_box=False, box_from=[0, 0, 0], box_to=[2, 2, 2], periodic=True)
+    st.push(AddNode("Voxel", {"E": 1.0, "nu": 0.3}, node_id="vox"))
+    st.push(Connect("solid", "solid", "vox", "solid"))
+    st.push(AddNode("MaterialMatrix", {"resolution": 0}, node_id="mat"))
+    st.push(Connect("vox", "voxels", "mat", "voxels"))
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    solid = res.output("solid")
+    assert mesh_volume(solid.vertices, solid.faces) / 8.0 == pytest.approx(0.3, abs=0.01)
+    c = res.output("mat").C
+    assert c[0, 0] == pytest.approx(c[1, 1], rel=1e-6) == pytest.approx(c[2, 2], rel=1e-6)   # cubic
+    assert 0 < c[0, 0] < 0.3                                         # below the Voigt bound E * f
+
+
+def test_particles_in_a_box_have_the_volume_of_the_clouds_own_particles():
+    doc, st = _graph()
+    params = {"cell": 1.0, "shape": "sphere", "distribution": "uniform", "size_a": 0.2, "size_b": 0.35,
+              "jitter": 1.0, "density": 0.7, "seed": 5}
+    st.push(AddNode("Particles", params, node_id="p"))
+    _solid(st, "p", resolution=120, fit_box=False, box_from=[0, 0, 0], box_to=[4, 4, 4])
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    cloud = res.output("p")
+    assert isinstance(cloud, Suspension) and cloud.seed == 5
+    found = cloud.particles_in_box(np.zeros(3), np.full(3, 4.0))
+    own = np.all((found.cells >= 0) & (found.cells <= 3), axis=1)       # the box's 64 cells
+    found = found._replace(**{k: getattr(found, k)[own] for k in found._fields})
+    inside = np.all((found.centres - found.radii[:, None] >= 0) & (found.centres + found.radii[:, None] <= 4), 1)
+    assert inside.all()                              # cells of a box of whole cells: no particle is cut
+    want = float(np.sum(4 / 3 * math.pi * found.sizes ** 3))
+    solid = res.output("solid")
+    assert mesh_volume(solid.vertices, solid.faces) == pytest.approx(want, rel=0.02)
+    assert 0.5 * 64 < len(found.sizes) < 0.9 * 64    # density 0.7 of 64 cells
+
+
+def test_a_suspension_blended_with_a_unit_cell_keeps_both():
+    doc, st = _graph()
+    st.push(AddNode("Vertex", {"position": [0.0, 0.0, 0.0]}, node_id="a"))
+    st.push(AddNode("Vertex", {"position": [1.0, 1.0, 1.0]}, node_id="b"))
+    st.push(AddNode("EdgeChain", node_id="e"))
+    st.push(Connect("a", "point", "e", "vertices"))
+    st.push(Connect("b", "point", "e", "vertices"))
+    st.push(AddNode("Line", {"thickness": [[0, 0.2]]}, node_id="l"))
+    st.push(Connect("e", "chain", "l", "chains"))
+    st.push(AddNode("Object", {"resolution": 32}, node_id="o"))
+    st.push(Connect("l", "skeleton", "o", "skeleton"))
+    st.push(AddNode("CellSDF", node_id="cell"))
+    st.push(Connect("o", "solid", "cell", "solid"))
+    st.push(AddNode("Particles", {"cell": 0.25, "size_a": 0.04, "size_b": 0.08, "seed": 2}, node_id="p"))
+    st.push(AddNode("SDFBoolean", {"operation": "smooth union", "blend": 0.02}, node_id="u"))
+    st.push(Connect("cell", "sdf", "u", "a"))
+    st.push(Connect("p", "sdf", "u", "b"))
+    _solid(st, "u", resolution=48, fit_box=False, box_from=[0, 0, 0], box_to=[1, 1, 1])
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    strut = res.output("o")
+    both = res.output("solid")
+    v_strut = mesh_volume(strut.vertices, strut.faces)
+    v_both = mesh_volume(both.vertices, both.faces)
+    assert v_both > 1.1 * v_strut                       # the particles added material
+    cell_sdf = res.output("cell")
+    p = np.random.default_rng(0).uniform(0, 1, (2000, 3))
+    shifted = cell_sdf.field(p + [1.0, -2.0, 3.0])       # the cell repeats over space
+    assert np.allclose(shifted, cell_sdf.field(p), atol=1e-9)
+
+
+def test_transform_and_offset_nodes_act_on_a_bounded_sdf_and_round_trip_the_project():
+    doc, st = _graph()
+    st.push(AddNode("Particles", {"cell": 1.0, "distribution": "fixed", "size_a": 0.3, "jitter": 0.0,
+                                  "density": 1.0}, node_id="p"))
+    st.push(AddNode("SDFTransform", {"scale": [2.0, 1.0, 1.0], "rotate": [0, 0, 90]}, node_id="t"))
+    st.push(Connect("p", "sdf", "t", "sdf"))
+    st.push(AddNode("SDFOffset", {"mode": "offset", "amount": 0.05}, node_id="off"))
+    st.push(Connect("t", "sdf", "off", "sdf"))
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    sdf = res.output("off")
+    # the lattice sphere at (0.5, 0.5, 0.5) scaled x2 along x then turned 90 deg about z:
+    # an ellipsoid at (-0.5, 1, 0.5) with semi-axes 0.3 along x and 0.6 along y, offset 0.05 outwards
+    assert sdf.field([-0.5, 1.0, 0.5])[0] < 0
+    # along x (the unscaled axis) the distance is exact: the offset surface is 0.3 + 0.05 out
+    assert sdf.distance([-0.5 - 0.36, 1.0, 0.5])[0] == pytest.approx(0.01, abs=1e-9)
+    assert sdf.distance([-0.5 - 0.34, 1.0, 0.5])[0] < 0
+    # along y (stretched x2) it is a lower bound: half the child's distance, still positive beyond
+    assert 0 < sdf.distance([-0.5, 1.0 + 0.6 + 0.2, 0.5])[0] < 0.2 - 0.05
+    assert sdf.lipschitz == pytest.approx(1.0)           # the inverse map stretches by at most 1
+    again = document_from_dict(document_to_dict(doc))
+    assert Evaluator().evaluate(again).output("off").field([0.1, 0.2, 0.3]) == pytest.approx(
+        sdf.field([0.1, 0.2, 0.3]))
+
+
+@pytest.mark.parametrize("node, params, where", [
+    ("Particles", {"cell": 0.5, "distribution": "fixed", "size_a": 0.3}, "size_a"),
+    ("Particles", {"cell": 1.0, "offset": 0.6}, "offset"),
+    ("PeriodicFunction", {"graded": True, "cell_end": 2.0, "grade_from": 5.0, "grade_to": 1.0}, "grade_to"),
+    ("PeriodicFunction", {"variant": "sheet", "level_by": "level", "level": -0.2}, "level"),
+])
+def test_bad_parameters_are_refused_at_the_parameter(node, params, where):
+    doc, st = _graph()
+    st.push(AddNode(node, params, node_id="n"))
+    res = Evaluator().evaluate(doc)
+    assert not res.ok
+    err = res.results["n"]
+    assert err.where == where, (err.error, err.where)
+
+
+def test_an_empty_box_is_refused_before_any_mesh_and_the_graph_is_kept():
+    doc, st = _graph()
+    st.push(AddNode("Particles", {"cell": 1.0, "density": 0.0}, node_id="p"))
+    _solid(st, "p", resolution=16, fit_box=False, box_from=[0, 0, 0], box_to=[2, 2, 2])
+    res = Evaluator().evaluate(doc)
+    assert "nothing of the medium" in res.errors["solid"]
+    assert res.results["solid"].where == "box_to" and set(doc.snapshot().nodes) == {"p", "solid"}
+    st.push(SetParam("p", "density", 1.0))
+    assert Evaluator().evaluate(doc).ok
