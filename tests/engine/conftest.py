@@ -1,3 +1,5 @@
+"""Fixtures shared by the engine tests: `gpu`, the headless OpenGL context (GPU and implicit tests)."""
+
 import pytest
 
 from engine.gpu.context import GpuUnavailable, gpu_context
