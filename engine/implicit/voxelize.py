@@ -104,6 +104,12 @@ def solid_from_samples(samples: np.ndarray, lo, hi, periodic: bool, *, progress=
     cells = np.array(s.shape) - (0 if periodic else 1)
     if s.ndim != 3 or np.any(cells < 2):
         raise ValueError(f"samples of shape {s.shape} do not make a grid over the box")
+    # samples on (or within a hair of) the surface moved 1 % of a spacing off it: marching
+    # cubes would put a vertex on the node, and where that node is on the box face the cap's
+    # vertex lands on the same point (welded: a non-manifold edge).  Periodic functions at
+    # level 0 are exactly zero on whole lines of nodes.
+    hair = np.float32(0.01 * float((edges / cells).min()))
+    s = np.where(np.abs(s) < hair, np.where(s < 0, -hair, hair), s).astype(np.float32)
     inside = s < 0
     if not inside.any():
         raise ValueError("nothing of the medium lies in the box: no sample is inside")
