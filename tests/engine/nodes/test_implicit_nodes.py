@@ -143,3 +143,40 @@ def test_an_empty_box_is_refused_before_any_mesh_and_the_graph_is_kept():
     assert res.results["solid"].where == "box_to" and set(doc.snapshot().nodes) == {"p", "solid"}
     st.push(SetParam("p", "density", 1.0))
     assert Evaluator().evaluate(doc).ok
+
+
+def test_agglomerated_fibres_have_the_volume_of_overlapping_spheres_in_rows():
+    """Fibres along z every 4 cells: rows of spheres of radius r = 0.7 w overlapping their
+    neighbours; per sphere the ball minus the two caps beyond the half-way planes."""
+    w, r, period = 0.1, 0.07, 4
+    doc, st = _graph()
+    st.push(AddNode("Agglomerate", {"cell": w, "size": r, "structure": "fibres", "period": period,
+                                    "axis": "z"}, node_id="a"))
+    _solid(st, "a", resolution=160, fit_box=False, box_from=[0, 0, 0], box_to=[0.8, 0.8, 0.8], periodic=True)
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    h = r - w / 2
+    per_sphere = 4 / 3 * math.pi * r ** 3 - 2 * math.pi * h * h * (3 * r - h) / 3
+    want = per_sphere / (period * period * w ** 3)
+    assert res.output("solid").volume_fraction == pytest.approx(want, rel=0.03)
+
+
+def test_a_pile_of_grains_goes_from_convex_to_concave_along_its_axis():
+    doc, st = _graph()
+    st.push(AddNode("Pile", {"grain": "sphere", "radius": 0.45, "deform": [0.0, 0.0, 0.0], "concavity": 0.0,
+                             "graded": True, "concavity_end": 1.0, "grade_from": 0.0, "grade_to": 4.0},
+                    node_id="p"))
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    pile = res.output("p")
+    centre_low, centre_high = np.array([0.5, 0.5, 0.5]), np.array([0.5, 0.5, 3.5])
+    probe = np.array([0.0, 0.0, 0.4])                       # inside the ball near its top pole
+    assert pile.field(centre_low + probe)[0] < 0             # convex low in the pile
+    assert pile.field(centre_high + probe)[0] > 0            # dimpled away high in the pile
+
+
+def test_a_particle_larger_than_the_lattice_cell_is_refused_at_size():
+    doc, st = _graph()
+    st.push(AddNode("Agglomerate", {"cell": 0.1, "size": 0.2}, node_id="a"))
+    res = Evaluator().evaluate(doc)
+    assert res.results["a"].where == "size", res.errors
