@@ -10,6 +10,10 @@
     mesoforge phasor PROJECT.json [--slice z=MM --png out.png] [--json] [--gcode out.gcode] [--printability] [--node ID]
     mesoforge rd --preset cantilever|lbeam|bridge|mbb3d [--res WxH[xD]] [--grow-res WxH[xD]] --out OUT.png|OUT.stl
                  [--fields FILE.npz|.vti] [--seed N] [--json]
+    mesoforge sdf GRAPH.json --render OUT.png [--size WxH] [--step fixed|bijection|adaptive] [--camera ...]
+                 [--paths N] [--json]  |  --voxels N --out OUT.stl|OUT.npy [--node ID] [--json]
+    mesoforge reconstruct GRAPH.json --node ID --exemplar FILE [--algorithm cmaes|powell|basinhopping|shgo]
+                 [--budget SECONDS] [--fit NAME=LO:HI ...] [--out FITTED.json] [--json]
 
 Exit codes: 0 done; 1 a node failed on valid input; 2 bad input, refused
 before any work starts or any file is written, with one line on stderr
@@ -35,7 +39,7 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-COMMANDS = ("eval", "render", "homogenize", "grow", "study", "phasor", "rd")
+COMMANDS = ("eval", "render", "homogenize", "grow", "study", "phasor", "rd", "sdf", "reconstruct")
 
 
 class _Refused(ValueError):
@@ -273,6 +277,10 @@ def build_parser() -> argparse.ArgumentParser:
     phasor_cmd.add_parsers(sub)
     from app import rd_cmd
     rd_cmd.add_parsers(sub)
+    from app import sdf_cmd
+    sdf_cmd.add_parsers(sub)
+    from app import reconstruct_cmd
+    reconstruct_cmd.add_parsers(sub)
     return p
 
 
@@ -299,6 +307,12 @@ def _dispatch(argv: list[str]) -> int:
     if args.command == "rd":
         from app import rd_cmd
         return rd_cmd.run(args)
+    if args.command == "sdf":
+        from app import sdf_cmd
+        return sdf_cmd.run(args)
+    if args.command == "reconstruct":
+        from app import reconstruct_cmd
+        return reconstruct_cmd.run(args)
     build_parser().print_help()
     return 2
 
