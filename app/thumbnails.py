@@ -35,7 +35,7 @@ def _preview_document(path):
     doc = load_project(path)
     stack = UndoStack(doc)
     for nid, node in doc.nodes.items():
-        if node.type_name == "Object" and node.params.get("resolution", 0) > PREVIEW_RESOLUTION:
+        if node.type_name in ("Object", "SDFSolid") and node.params.get("resolution", 0) > PREVIEW_RESOLUTION:
             stack.push(SetParam(nid, "resolution", PREVIEW_RESOLUTION))
         elif node.type_name == "MaterialMatrix":
             stack.push(SetParam(nid, "resolution", PREVIEW_SOLVE))

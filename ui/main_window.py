@@ -237,6 +237,7 @@ class MainWindow(WindowDocks, WindowLayout, WindowMenus, WindowEvaluation, Windo
         self.phasor_panel.shutdown()
         self.rd_panel.shutdown()
         self.surface_panel.shutdown()
+        self.implicit_panel.shutdown()
         self.subgraph_panel.detach()
         self.worker.shutdown()
         self.editor.detach()

@@ -12,6 +12,7 @@ from __future__ import annotations
 from PySide6 import QtCore, QtWidgets
 
 from .growth_panel import GrowthPanel
+from .implicit_panel import ImplicitPanel
 from .inspector import Inspector
 from .node_editor import NodeEditor
 from .phasor_panel import PhasorPanel
@@ -76,6 +77,11 @@ class WindowDocks:
         self.surface_panel.message.connect(self.log)
         self.editor.selection_changed.connect(self.surface_panel.set_selected)
         self.evaluation_finished.connect(self.surface_panel.set_report)
+        self.implicit_panel = ImplicitPanel(self.doc, self.undo, self)
+        self.implicit_dock = self._dock("Implicit Media", self.implicit_panel)
+        self.implicit_panel.message.connect(self.log)
+        self.editor.selection_changed.connect(self.implicit_panel.set_selected)
+        self.evaluation_finished.connect(self.implicit_panel.set_report)
 
         bottom = QtWidgets.QWidget()
         lay = QtWidgets.QVBoxLayout(bottom)

@@ -31,9 +31,9 @@ KEY_DOCKS = "window/docks"
 
 LEFT_DOCKS = ("editor_dock",)
 RIGHT_TABS = ("inspector_dock", "surface_dock", "growth_dock", "tileset_dock", "study_dock",
-              "phasor_dock", "rd_dock")
+              "phasor_dock", "rd_dock", "implicit_dock")
 """Tabbed on the right, in this order: the inspector, then the method docks in the order of
-the methods (unit cell, virtual growth, phasor infill, reaction diffusion)."""
+the methods (unit cell, virtual growth, phasor infill, reaction diffusion, implicit media)."""
 BOTTOM_DOCKS = ("log_dock",)
 
 EDITOR_SHARE = 0.26          # of the window's width, for the node graph

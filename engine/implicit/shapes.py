@@ -346,5 +346,24 @@ class Primitive(SDF):
             f"float {n}(vec3 p) {{ return {helper}({q}, {args}); }}"))
 
     def box(self):
-        r = self.bounding_radius
-        return (tuple(v - r for v in self.centre), tuple(v + r for v in self.centre))
+        """Centre +- the shape's half-extents when it is not rotated and they are known (box,
+        round box, ellipsoid, sphere, cylinder, capsule, torus), else +- the bounding radius."""
+        half = None if self.rotation is not None else _half_extents(self.shape, self.params)
+        if half is None:
+            half = (self.bounding_radius,) * 3
+        return (tuple(c - h for c, h in zip(self.centre, half)), tuple(c + h for c, h in zip(self.centre, half)))
+
+
+def _half_extents(shape: str, p: tuple):
+    """The axis-aligned half-extents of an unrotated shape, or None where not worked out."""
+    if shape in ("box", "round_box", "ellipsoid"):
+        return tuple(p[:3])
+    if shape == "sphere":
+        return (p[0],) * 3
+    if shape == "cylinder":
+        return (p[1], p[1], p[0])
+    if shape == "capsule":
+        return (p[1], p[1], p[0] + p[1])
+    if shape == "torus":
+        return (p[0] + p[1], p[0] + p[1], p[1])
+    return None

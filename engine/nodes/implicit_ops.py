@@ -14,11 +14,50 @@ from engine.graph.schema import Param, Port
 from engine.implicit.combine import (Affine, Difference, Intersection, Offset, Shell, SmoothDifference,
                                      SmoothIntersection, SmoothUnion, Union)
 from engine.implicit.sampled import Sampled
+from engine.implicit.shapes import SHAPES, Primitive
 
 from .implicit_common import built
 
 BOOLEANS = ("union", "intersection", "difference", "smooth union", "smooth intersection",
             "smooth difference")
+
+
+def shape_params(shape: str, extent, rounding: float) -> tuple:
+    """A shape's parameters (mm) from the node's box-like `extent` (full widths along x, y, z)
+    and `rounding`: sphere r = x / 2; ellipsoid semi-axes; box half-extents; round box
+    half-extents and rounding; torus R = x / 2 - the tube, r = z / 2; capsule, cylinder and
+    hexagonal prism along z (half-height z / 2, radius / apothem x / 2)."""
+    x, y, z = (0.5 * float(v) for v in extent)
+    return {"sphere": (x,), "ellipsoid": (x, y, z), "box": (x, y, z), "round_box": (x, y, z, float(rounding)),
+            "torus": (x - z, z), "capsule": (max(z - x, 1e-9), x), "cylinder": (z, x),
+            "hex_prism": (z, x)}[shape]
+
+
+@register
+class SDFShapeNode(NodeType):
+    """One solid shape (sphere, ellipsoid, box, round box, torus, capsule, cylinder or
+    hexagonal prism) sized by its extents along x, y, z and placed at a centre: the block of ice
+    a cloud of bubbles is cut from, a mould, a blob to blend a lattice into."""
+
+    type_name = "SDFShape"
+    title = "SDF Shape"
+    code = "sdp"
+    family = "implicit"
+    outputs = (Port("sdf", "SDF"),)
+    params = (
+        Param("shape", "enum", "box", choices=tuple(SHAPES), doc="the shape"),
+        Param("extent", "vec3", [1.0, 1.0, 1.0], 1e-4, 1e4, unit="mm",
+              doc="full widths along x, y, z (a sphere uses x; z is the axis of torus, capsule, "
+                  "cylinder and prism; a torus's tube is z wide)"),
+        Param("rounding", "float", 0.05, 0.0, 1e4, unit="mm", doc="edge rounding of a round box"),
+        Param("centre", "vec3", [0.5, 0.5, 0.5], -1e4, 1e4, unit="mm", doc="where the shape's centre is"),
+    )
+
+    def evaluate(self, inputs, params, ctx):
+        def make():
+            return Primitive(params["shape"], shape_params(params["shape"], params["extent"], params["rounding"]),
+                             centre=tuple(params["centre"]))
+        return {"sdf": built(make, params, {"rounding": "rounding", "R ": "extent", "r ": "extent", "h ": "extent"})}
 
 
 @register

@@ -22,7 +22,8 @@ from engine.implicit.values import SDF
 from engine.implicit.volume_fraction import volume_fraction
 from engine.implicit.voxelize import check_box
 
-__all__ = ["PREVIEW_PARAMS", "SDFPreview", "preview_param", "DEFAULT_VIEW_BOX", "MAX_HISTOGRAM_PARTICLES"]
+__all__ = ["PREVIEW_PARAMS", "SDFPreview", "preview_param", "orbit_direction", "DEFAULT_ORBIT",
+           "DEFAULT_VIEW_BOX", "MAX_HISTOGRAM_PARTICLES"]
 
 DEFAULT_VIEW_BOX = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))     # mm: an unbounded medium's view without a box
 MAX_HISTOGRAM_PARTICLES = 200_000
@@ -41,6 +42,17 @@ PREVIEW_PARAMS = (
     Param("max_depth", "int", 8, 1, 256, doc="longest light path (bounces) when path tracing"),
     Param("fov", "float", 40.0, 1.0, 170.0, unit="deg", doc="vertical field of view of the default camera"),
 )
+
+
+def orbit_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
+    """The unit vector from the target towards the eye at `azimuth` (about +z, from +x) and
+    `elevation` (above the xy plane), degrees; elevation is kept within +-89."""
+    az = math.radians(float(azimuth_deg))
+    el = math.radians(max(-89.0, min(89.0, float(elevation_deg))))
+    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+
+
+DEFAULT_ORBIT = (-52.6, 27.2)        # degrees: VIEW_DIRECTION as azimuth, elevation
 
 
 def preview_param(name: str) -> Param:
@@ -68,16 +80,18 @@ class SDFPreview:
         lo, hi = check_box(*box)
         self.box = (lo, hi)
 
-    def camera(self, fov: float = 40.0, direction=None) -> Camera:
+    def camera(self, fov: float = 40.0, direction=None, zoom: float = 1.0) -> Camera:
         """A camera looking at the view box's centre from `direction` (default from the front
-        right, above), far enough for the box's bounding sphere to fit the field of view."""
+        right, above), far enough for the box's bounding sphere to fit the field of view, then
+        `zoom` times closer."""
         lo, hi = self.box
         centre = 0.5 * (lo + hi)
         radius = 0.5 * float(np.linalg.norm(hi - lo))
         d = np.asarray(VIEW_DIRECTION if direction is None else direction, dtype=np.float64)
         d = d / np.linalg.norm(d)
-        distance = 1.05 * radius / math.sin(math.radians(0.5 * float(fov)))
-        return Camera(centre + distance * d, centre, (0.0, 0.0, 1.0), float(fov))
+        distance = 1.05 * radius / math.sin(math.radians(0.5 * float(fov))) / float(zoom)
+        up = (0.0, 0.0, 1.0) if abs(d[2]) < 0.999 else (0.0, 1.0, 0.0)
+        return Camera(centre + distance * d, centre, up, float(fov))
 
     def trace(self, camera: Camera | None = None, *, width: int = 512, height: int = 512,
               step: str = "adaptive", adaptive_every: int = 100, max_steps: int = 512, fov: float = 40.0,

@@ -35,7 +35,7 @@ def test_every_form_dock_scrolls_to_all_of_its_content(window, qtbot):
     docks = _scrolled_docks(window)
     titles = {d.windowTitle() for d in docks}
     assert {"Inspector", "Virtual Growth", "Tile Sets", "Phasor Infill", "Reaction Diffusion", "Studies",
-            "Surfaces"} <= titles
+            "Surfaces", "Implicit Media"} <= titles
     # the rest scroll themselves: the node graph is a graphics view, the log a text view
     others = [d for d in window.findChildren(QtWidgets.QDockWidget) if d not in docks]
     for dock in others:

@@ -9,7 +9,8 @@ from PySide6 import QtCore, QtWidgets
 
 from ui.window_layout import KEY_DOCKS, KEY_STATE, dock_arrangement
 
-METHOD_DOCKS = {"Surfaces", "Virtual Growth", "Tile Sets", "Studies", "Phasor Infill", "Reaction Diffusion"}
+METHOD_DOCKS = {"Surfaces", "Virtual Growth", "Tile Sets", "Studies", "Phasor Infill", "Reaction Diffusion",
+                "Implicit Media"}
 
 
 @pytest.fixture

@@ -180,3 +180,25 @@ def test_a_particle_larger_than_the_lattice_cell_is_refused_at_size():
     st.push(AddNode("Agglomerate", {"cell": 0.1, "size": 0.2}, node_id="a"))
     res = Evaluator().evaluate(doc)
     assert res.results["a"].where == "size", res.errors
+
+
+@pytest.mark.parametrize("shape, volume", [
+    ("box", 1.0 * 0.8 * 0.4),
+    ("ellipsoid", 4 / 3 * math.pi * 0.5 * 0.4 * 0.2),
+    ("cylinder", math.pi * 0.5 ** 2 * 0.4),
+    ("torus", 2 * math.pi ** 2 * 0.3 * 0.2 ** 2),          # R = 0.5 - 0.2, tube radius 0.2
+])
+def test_sdf_shapes_have_their_closed_form_volumes_and_tight_boxes(shape, volume):
+    doc, st = _graph()
+    st.push(AddNode("SDFShape", {"shape": shape, "extent": [1.0, 0.8, 0.4], "centre": [0.2, -0.1, 0.3]},
+                    node_id="s"))
+    _solid(st, "s", resolution=128)
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    solid = res.output("solid")
+    assert mesh_volume(solid.vertices, solid.faces) == pytest.approx(volume, rel=0.01)
+    lo, hi = (np.array(v) for v in res.output("s").box())
+    assert np.allclose(hi - lo, [1.0, 0.8 if shape in ("box", "ellipsoid") else 1.0, 0.4])
+    p = np.random.default_rng(1).uniform(-2, 2, (50000, 3))
+    outside = np.any((p < lo) | (p > hi), axis=1)
+    assert np.all(res.output("s").field(p[outside]) > 0)
