@@ -51,8 +51,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--camera", metavar="EX,EY,EZ,TX,TY,TZ,FOV_DEG",
                    help="eye, target (mm) and vertical field of view (deg); default: framing the view box")
     p.add_argument("--view-box", metavar="X0,Y0,Z0,X1,Y1,Z1",
-                   help="box the rays are clipped to (mm); default the SDF's own box, or [0, 1]^3 for a "
-                        "medium that fills space")
+                   help="box the rays are clipped to (mm); default the SDF's own box, else (a medium that "
+                        "fills space) the box of the SDF Solid node below it, else [0, 1]^3")
     p.add_argument("--voxels", metavar="N", help="voxelise at N along the longest box edge (SDF Solid resolution)")
     p.add_argument("--out", metavar="OUT", help="mesh (" + " ".join(MESH_SUFFIXES) + ") or .npy to write")
     _flags["SDFSolid"] = add_param_flags(p, "SDFSolid", SOLID_FLAGS)
@@ -228,7 +228,8 @@ def run(args) -> int:
         info = _write_voxels(report.output(target), report.output(node, "sdf"), plan, graph)
     else:
         try:
-            info = _write_render(report.output(node, "sdf"), plan)
+            from engine.nodes.sdf_preview import fallback_box_for
+            info = _write_render(report.output(node, "sdf"), plan, fallback_box_for(doc, node))
         except ValueError as exc:
             return _fail(str(exc), 1, cmd="sdf")
     info["node"] = node
@@ -264,12 +265,12 @@ def _write_voxels(solid, sdf, plan, graph) -> dict:
     return info
 
 
-def _write_render(sdf, plan) -> dict:
+def _write_render(sdf, plan, fallback_box=None) -> dict:
     from engine.fileio import write_atomic
     from engine.gpu.camera import format_camera
     from engine.nodes.sdf_preview import SDFPreview
 
-    preview = SDFPreview(sdf, plan["view_box"])
+    preview = SDFPreview(sdf, plan["view_box"], fallback_box)
     camera = plan.get("camera") or preview.camera()
     w, h = plan["size"]
     if plan["paths"] > 0:

@@ -13,7 +13,8 @@ GROWTH = "virtual growth"
 PHASOR = "phasor infill"
 RD = "reaction diffusion"
 PROPERTIES = "properties"
-FAMILIES = (LATTICE, SHELL, PROPERTIES, GROWTH, PHASOR, RD)
+IMPLICIT = "implicit media"
+FAMILIES = (LATTICE, SHELL, PROPERTIES, GROWTH, PHASOR, RD, IMPLICIT)
 
 CATALOGUE: dict[str, tuple[str, str]] = {
     # unit-cell trusses and beam lattices (paper Table 4)
@@ -58,6 +59,14 @@ CATALOGUE: dict[str, tuple[str, str]] = {
     # phasor infill and reaction diffusion
     "phasor_slab": (PHASOR, "A painted slab of phasor-noise diamond cells, sliced at mid height."),
     "rd_cantilever": (RD, "A SIMP cantilever filled with Gray-Scott stripes along its stress directions."),
+    # implicit media (paper 004)
+    "implicit_multiphase": (IMPLICIT, "Two particle clouds, spheres and turned rounded boxes, in one medium."),
+    "implicit_ice_bubbles": (IMPLICIT, "A block of ice with air bubbles thinning out towards the top."),
+    "implicit_paper_fibres": (IMPLICIT, "A gyroid sheet pressed flat into interwoven paper-like fibres."),
+    "implicit_rock_pile": (IMPLICIT, "Piled grains on a deformed lattice, convex at the bottom, dimpled on top."),
+    "implicit_porous_lattice": (IMPLICIT, "Lattice spheres kept by a congruence rule: an open frame, homogenised."),
+    "implicit_graded_gyroid": (IMPLICIT, "A gyroid network graded from 15 % to 50 % solid along its height."),
+    "implicit_suspension_octet": (IMPLICIT, "The octet cell blended with a cloud of small spheres by a smooth union."),
 }
 
 

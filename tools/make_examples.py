@@ -701,11 +701,21 @@ def _surface_examples():
 SURFACE_EXAMPLES, write_surface_examples = _surface_examples()
 
 
+def _implicit_examples():
+    """The implicit media examples live in tools/implicit_examples.py."""
+    from implicit_examples import IMPLICIT_EXAMPLES, write_implicit_examples
+    return IMPLICIT_EXAMPLES, write_implicit_examples
+
+
+IMPLICIT_EXAMPLES, write_implicit_examples = _implicit_examples()
+
+
 def all_writers() -> dict[str, tuple[dict, Callable]]:
     """Every example generator: ``{kind: (its builders by name, its writer)}``."""
     return {"cells": (EXAMPLES, write_examples), "properties": (PROPERTY_EXAMPLES, write_property_examples),
             "growth": (GROWTH_EXAMPLES, write_growth_examples), "phasor": (PHASOR_EXAMPLES, write_phasor_examples),
-            "rd": (RD_EXAMPLES, write_rd_examples), "surfaces": (SURFACE_EXAMPLES, write_surface_examples)}
+            "rd": (RD_EXAMPLES, write_rd_examples), "surfaces": (SURFACE_EXAMPLES, write_surface_examples),
+            "implicit": (IMPLICIT_EXAMPLES, write_implicit_examples)}
 
 
 def write_all(out_dir: str | Path = EXAMPLES_DIR, names=None) -> dict[Path, GraphDocument]:

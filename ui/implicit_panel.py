@@ -24,7 +24,7 @@ from PySide6 import QtCore, QtWidgets
 from engine.graph import all_node_types
 from engine.graph.query import pick_node
 from engine.implicit.values import SDF
-from engine.nodes.sdf_preview import SDFPreview, orbit_direction, preview_param
+from engine.nodes.sdf_preview import SDFPreview, fallback_box_for, orbit_direction, preview_param
 
 from .colours import STATUS_COLOURS
 from .implicit_plots import SizeHistogram
@@ -223,7 +223,7 @@ class ImplicitPanel(QtWidgets.QWidget):
             self.histogram.set_sizes(None, "no suspension")
             return
         try:
-            self.preview = SDFPreview(sdf)
+            self.preview = SDFPreview(sdf, fallback_box=fallback_box_for(self.doc, self.node_id))
         except ValueError as exc:
             self._set_sdf(None, str(exc))
             return

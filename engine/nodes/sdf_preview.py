@@ -22,7 +22,7 @@ from engine.implicit.values import SDF
 from engine.implicit.volume_fraction import volume_fraction
 from engine.implicit.voxelize import check_box
 
-__all__ = ["PREVIEW_PARAMS", "SDFPreview", "preview_param", "orbit_direction", "DEFAULT_ORBIT",
+__all__ = ["PREVIEW_PARAMS", "SDFPreview", "preview_param", "orbit_direction", "fallback_box_for", "DEFAULT_ORBIT",
            "DEFAULT_VIEW_BOX", "MAX_HISTOGRAM_PARTICLES"]
 
 DEFAULT_VIEW_BOX = ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))     # mm: an unbounded medium's view without a box
@@ -55,6 +55,21 @@ def orbit_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
 DEFAULT_ORBIT = (-52.6, 27.2)        # degrees: VIEW_DIRECTION as azimuth, elevation
 
 
+def fallback_box_for(doc, node_id: str | None):
+    """The box an SDF node is viewed in when its SDF has none of its own (a medium that fills
+    space): the box of the SDF Solid node below it, as ``(lo, hi)``, or None."""
+    from engine.graph.query import downstream_of_type
+
+    solid = downstream_of_type(doc, node_id, "SDFSolid") if node_id else None
+    if solid is None:
+        return None
+    params = doc.nodes[solid].params
+    lo, hi = params.get("box_from"), params.get("box_to")
+    if lo is None or hi is None or any(b <= a for a, b in zip(lo, hi)):
+        return None
+    return (tuple(lo), tuple(hi))
+
+
 def preview_param(name: str) -> Param:
     return next(p for p in PREVIEW_PARAMS if p.name == name)
 
@@ -63,7 +78,8 @@ class SDFPreview:
     """The preview of one SDF value over a view box.
 
     sdf : the SDF (any engine.implicit tree).
-    view_box : ((x0, y0, z0), (x1, y1, z1)) mm, or None: the SDF's own box, else
+    view_box : ((x0, y0, z0), (x1, y1, z1)) mm, the box viewed; None: the SDF's own box, else
+        `fallback_box` (for a medium that fills space, e.g. `fallback_box_for` the node), else
         `DEFAULT_VIEW_BOX`.
 
     Raises
@@ -72,11 +88,11 @@ class SDFPreview:
         For a value that is not an SDF or a box that is not three edges > 0.
     """
 
-    def __init__(self, sdf: SDF, view_box=None):
+    def __init__(self, sdf: SDF, view_box=None, fallback_box=None):
         if not isinstance(sdf, SDF):
             raise ValueError(f"expected an SDF value, got {type(sdf).__name__}")
         self.sdf = sdf
-        box = view_box if view_box is not None else (sdf.box() or DEFAULT_VIEW_BOX)
+        box = view_box or sdf.box() or fallback_box or DEFAULT_VIEW_BOX
         lo, hi = check_box(*box)
         self.box = (lo, hi)
 
