@@ -12,7 +12,7 @@ import pytest
 
 from engine.implicit.exemplar import Exemplar
 from engine.implicit.fourier_loss import fourier_loss
-from engine.implicit.reconstruct import ParamSpace, fit, validation_error
+from engine.implicit.reconstruct import ParamSpace, fit, minimise, validation_error
 from engine.implicit.synthetic import synthetic_case
 from engine.implicit.values import SDF, as_points
 from engine.progress import Cancelled
@@ -249,3 +249,48 @@ def test_every_case_is_minimal_at_its_truth_on_axis_scans(name):
             losses.append(fourier_loss(case.sdf(x).distance(ex.points).reshape(ex.shape), ex.grid()))
         others = np.abs(values[:-1] - case.true[i]) > 1e-9
         assert losses[-1] < np.min(np.array(losses[:-1])[others]), case.space.names[i]
+
+
+def _bowl_space():
+    return ParamSpace(("x", "y"), (-1.0, -1.0), (1.0, 2.0))
+
+
+@pytest.mark.parametrize("algorithm", ["cmaes", "powell", "basinhopping", "shgo"])
+def test_minimise_any_objective_finds_a_closed_form_minimum(algorithm):
+    seen = []
+
+    def bowl(v):
+        seen.append(np.array(v))
+        return (v[0] - 0.3) ** 2 + 2 * (v[1] + 0.2) ** 2 + 1.0
+
+    r = minimise(bowl, _bowl_space(), algorithm, math.inf, max_evaluations=600, seed=1)
+    np.testing.assert_allclose(r.params, [0.3, -0.2], atol=2e-3)
+    assert r.loss == pytest.approx(1.0, abs=1e-5) and r.names == ("x", "y")
+    assert len(seen) == r.evaluations
+    # the objective sees values inside the box, in parameter (not unit) coordinates
+    pts = np.array(seen)
+    assert np.all(pts >= [-1.0, -1.0]) and np.all(pts <= [1.0, 2.0]) and pts[:, 0].min() < 0.0
+
+
+def test_minimise_floor_cancel_inside_and_non_finite():
+    space = _bowl_space()
+    r = minimise(lambda v: abs(v[0] - 0.5) + abs(v[1]), space, "powell", math.inf, x0=(0.5, 0.0),
+                 floor=0.0, max_evaluations=50)
+    assert r.stopped_by == "converged" and r.evaluations == 1 and r.loss == 0.0
+    calls = {"n": 0}
+
+    def cancelled_inside(v):
+        calls["n"] += 1
+        if calls["n"] > 4:
+            raise Cancelled("from inside the objective")
+        return float(v[0] ** 2)
+
+    r = minimise(cancelled_inside, space, "cmaes", math.inf)
+    assert r.stopped_by == "cancel" and r.evaluations == 4
+    r = minimise(lambda v: math.nan if v[0] > 0 else float(-v[0]), space, "powell", math.inf,
+                 x0=(0.5, 0.0), max_evaluations=1)
+    assert r.loss == 1e300                                 # a NaN counts as a huge value
+    with pytest.raises(ValueError, match="objective"):
+        minimise("not callable", space, "powell", 1.0)
+    with pytest.raises(ValueError, match="space"):
+        minimise(lambda v: 0.0, (("x",), (0,), (1,)), "powell", 1.0)
