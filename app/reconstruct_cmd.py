@@ -1,13 +1,17 @@
 """`mesoforge reconstruct`: fit an SDF node's parameters to an exemplar (paper 004, section 6).
 
-    mesoforge reconstruct GRAPH.json --node ID --exemplar FILE.npy|.vti|.tif
+    mesoforge reconstruct GRAPH.json --node ID --exemplar FILE.npy|.vti|.tif|.png
                           [--algorithm cmaes|powell|basinhopping|shgo] [--budget SECONDS]
                           [--fit NAME=LO:HI ...] [--max-evaluations N] [--seed N]
-                          [--loss fourier|mse] [--out FITTED.json] [--json]
+                          [--loss fourier|mse] [--camera EX,EY,EZ,TX,TY,TZ,FOV] [--view-box ...]
+                          [--out FITTED.json] [--json]
 
 The exemplar is a signed-distance (or occupancy) grid: ``.npy`` (spacing and origin in mm from
 a ``<stem>.json`` sidecar ``{"spacing": [...], "origin": [...]}``, else 1 and 0), ``.vti`` or
-a ``.tif`` stack (`engine.implicit.exemplar.load_exemplar`).  ``--fit`` names the node's float
+a ``.tif`` stack (`engine.implicit.exemplar.load_exemplar`).  An image (``.png``, ``.jpg``,
+``.bmp``, a one-page ``.tif``) is fitted by analysis by synthesis (section 6.2): every candidate
+is sphere-traced at ``--camera`` (default: the view `mesoforge sdf --render` frames for the
+node as it is now, in ``--view-box`` or its box) and compared by the 2D DFT amplitudes (eq. 39).  ``--fit`` names the node's float
 parameters to fit and their bounds (repeatable); without it every non-zero float parameter is
 fitted within half its value either way.  The fit (`engine.nodes.sdf_fit.NodeFit`, the object
 the Implicit Media dock runs) starts from the node's current values and stops at the budget,
@@ -38,6 +42,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--seed", metavar="N", help=help_text(fit_param("seed")))
     p.add_argument("--loss", metavar="{fourier,mse}", help=help_text(fit_param("loss")))
     p.add_argument("--fit", action="append", metavar="NAME=LO:HI", help="a parameter to fit and its bounds")
+    p.add_argument("--camera", metavar="EX,EY,EZ,TX,TY,TZ,FOV_DEG",
+                   help="the camera an image exemplar was taken with (default: the sdf command's framing)")
+    p.add_argument("--view-box", metavar="X0,Y0,Z0,X1,Y1,Z1", help="box the rays are clipped to (image exemplars)")
     p.add_argument("--out", metavar="FITTED.json", help="write the project with the fitted values")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
 
@@ -64,7 +71,6 @@ def _setting(flag, text, name):
 def _check(args):
     from app.flags import FlagError, output_path
     from engine.graph import ProjectFileError, load_project, node_type
-    from engine.implicit.exemplar import load_exemplar
     from engine.nodes.sdf_fit import fit_param, parse_bounds
 
     try:
@@ -91,14 +97,31 @@ def _check(args):
                 raise FlagError("--fit", text, str(exc), "NAME=LO:HI") from None
             bounds[name] = (lo, hi)
     plan["bounds"] = bounds
-    try:
-        plan["exemplar"] = load_exemplar(args.exemplar)
-    except (ValueError, OSError) as exc:
-        raise FlagError("--exemplar", args.exemplar, str(exc), "a 3D grid in .npy, .vti or .tif") from None
+    plan["exemplar"], plan["image"] = _exemplar(args.exemplar)
+    if args.camera:
+        from engine.gpu.camera import parse_camera
+        try:
+            plan["camera"] = parse_camera(args.camera)
+        except ValueError as exc:
+            raise FlagError("--camera", args.camera, str(exc), "EX,EY,EZ,TX,TY,TZ,FOV_DEG") from None
+    if args.view_box:
+        from app.sdf_cmd import _box
+        plan["view_box"] = _box(args.view_box)
     plan["out"] = output_path("--out", args.out, (".json",))
     if plan["out"] is not None and plan["out"].resolve() == Path(args.graph).resolve():
         raise FlagError("--out", args.out, "is the input project", "another file (the input is never written)")
     return doc, plan
+
+
+def _exemplar(path):
+    from app.flags import FlagError
+    from engine.nodes.sdf_fit import load_any_exemplar
+
+    try:
+        return load_any_exemplar(path)
+    except ValueError as exc:
+        raise FlagError("--exemplar", path, str(exc),
+                        "a 3D grid (.npy .vti .tif) or an image (.png .jpg .bmp .tif)") from None
 
 
 def run(args) -> int:
@@ -128,9 +151,20 @@ def run(args) -> int:
         if not args.json:
             print(f"\r  fit: {100 * done:5.1f}%  loss {best:.4g}", end="", file=sys.stderr, flush=True)
 
-    result = fitting.fit(plan["exemplar"], algorithm=plan["algorithm"], budget=plan["budget"],
-                         max_evaluations=plan["max_evaluations"], seed=plan["seed"], loss=plan["loss"],
-                         progress=progress)
+    settings = dict(algorithm=plan["algorithm"], budget=plan["budget"], max_evaluations=plan["max_evaluations"],
+                    seed=plan["seed"], progress=progress)
+    view = {}
+    if plan["image"]:
+        from engine.gpu.camera import format_camera
+        from engine.nodes.sdf_preview import SDFPreview, fallback_box_for
+
+        preview = SDFPreview(fitting.sdf(fitting.start()), plan.get("view_box"), fallback_box_for(doc, args.node))
+        camera = plan.get("camera") or preview.camera()
+        bounds = (tuple(preview.box[0]), tuple(preview.box[1]))
+        result = fitting.fit_image(plan["exemplar"], camera, bounds=bounds, **settings)
+        view = {"camera": format_camera(camera), "view_box": [list(map(float, b)) for b in bounds]}
+    else:
+        result = fitting.fit(plan["exemplar"], loss=plan["loss"], **settings)
     if not args.json:
         print(file=sys.stderr)
     found = {n: float(v) for n, v in zip(result.names or fitting.names, result.params)}
@@ -138,7 +172,7 @@ def run(args) -> int:
             "start": {n: float(v) for n, v in zip(fitting.names, fitting.start())},
             "bounds": {n: list(b) for n, b in fitting.bounds.items()}, "loss": float(result.loss),
             "evaluations": int(result.evaluations), "seconds": float(result.seconds),
-            "stopped_by": result.stopped_by}
+            "stopped_by": result.stopped_by, "exemplar": "image" if plan["image"] else "grid", **view}
     if plan["out"] is not None:
         _write_fitted(doc, args.node, found, plan["out"])
         info["out"] = str(plan["out"].resolve())

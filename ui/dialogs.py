@@ -41,8 +41,8 @@ class Prompter:
     def error(self, title: str, text: str) -> None:
         QtWidgets.QMessageBox.critical(self.parent, title, text)
 
-    def open_path(self, caption: str, directory: str = "") -> str | None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(self.parent, caption, directory, PROJECT_FILTER)
+    def open_path(self, caption: str, directory: str = "", filters: str = PROJECT_FILTER) -> str | None:
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(self.parent, caption, directory, filters)
         return path or None
 
     def save_path(self, caption: str, directory: str = "", filters: str = PROJECT_FILTER) -> str | None:

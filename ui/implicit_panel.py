@@ -11,7 +11,9 @@ latest evaluation (slot :meth:`ImplicitPanel.set_report`):
 * "Path trace": progressive frames of the path tracer, each shown as it lands, cancellable;
 * the node's parameters (`ParamForm`: one ``SetParam`` per edit, refusals at the field), so an
   edit re-evaluates and the view follows;
-* the solid volume fraction of the view box and the particle size histogram of a suspension.
+* the solid volume fraction of the view box and the particle size histogram of a suspension;
+* "Fit to an exemplar" (`ui.implicit_fit.FitBox`): the node's parameters fitted to a grid, or
+  to an image taken at this view, applied as one undo step when asked.
 
 Every trace and measurement runs in a `TaskRunner` (a burst of view changes traces only the
 last); the GUI thread only draws.
@@ -27,6 +29,7 @@ from engine.implicit.values import SDF
 from engine.nodes.sdf_preview import SDFPreview, fallback_box_for, orbit_direction, preview_param
 
 from .colours import STATUS_COLOURS
+from .implicit_fit import FitBox
 from .implicit_plots import SizeHistogram
 from .implicit_view import TraceView
 from .param_form import ParamForm
@@ -85,9 +88,9 @@ class ImplicitPanel(QtWidgets.QWidget):
 
     message = QtCore.Signal(str, str)
 
-    def __init__(self, doc, undo, parent=None):
+    def __init__(self, doc, undo, parent=None, *, prompter=None):
         super().__init__(parent)
-        self.doc, self.undo = doc, undo
+        self.doc, self.undo, self.prompter = doc, undo, prompter
         self.node_id: str | None = None
         self.outputs: dict = {}
         self.results: dict = {}
@@ -160,6 +163,9 @@ class ImplicitPanel(QtWidgets.QWidget):
         self.param_form = ParamForm(self.doc, self.undo, self.form, self)
         self.param_form.message.connect(self.message.emit)
         outer.addWidget(self.params_box)
+        self.fit_box = FitBox(self.doc, self.undo, self.prompter, view=self.fit_view, parent=self)
+        self.fit_box.message.connect(self.message.emit)
+        outer.addWidget(self.fit_box)
         self._show_node()
 
     # -- which node -----------------------------------------------------------------------------
@@ -193,12 +199,14 @@ class ImplicitPanel(QtWidgets.QWidget):
             cls = all_node_types()[self.doc.nodes[nid].type_name] if nid else None
             self.param_form.show_node(nid, cls.params if cls else ())
         if nid is None:
+            self.fit_box.set_node(None, {})
             self.title.setText("No node with an SDF output: add Particles, Periodic Function, Agglomerate "
                                "or Pile (Tab in the node graph).")
             self._set_sdf(None, "select a node with an SDF output")
             return
         node = self.doc.nodes[nid]
         self.title.setText(f"<b>{node.type_name}</b> · {nid}")
+        self.fit_box.set_node(nid, self.node_inputs())
         result = self.results.get(nid)
         value = (self.outputs.get(nid) or {}).get("sdf")
         if result is not None and getattr(result, "status", "") == "failed":
@@ -229,6 +237,21 @@ class ImplicitPanel(QtWidgets.QWidget):
             return
         self.request_trace()
         self.measures.submit(_measure(self.preview))
+
+    def node_inputs(self) -> dict:
+        """The evaluated inputs of the node shown (from the latest evaluation)."""
+        if self.node_id is None:
+            return {}
+        return {e.dst_port: (self.outputs.get(e.src) or {}).get(e.src_port)
+                for e in self.doc.edges if e.dst == self.node_id}
+
+    def fit_view(self):
+        """(camera, bounds) of the traced view, what an image exemplar is compared at; None
+        before anything is traced."""
+        if self.preview is None:
+            return None
+        lo, hi = self.preview.box
+        return self.camera(), (tuple(lo), tuple(hi))
 
     # -- tracing --------------------------------------------------------------------------------
     def camera(self):
@@ -292,6 +315,7 @@ class ImplicitPanel(QtWidgets.QWidget):
         return self.traces.wait_idle(timeout_ms) and self.measures.wait_idle(timeout_ms)
 
     def shutdown(self) -> None:
+        self.fit_box.shutdown()
         self.traces.shutdown()
         self.measures.shutdown()
         self.histogram.shutdown()

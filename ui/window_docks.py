@@ -77,7 +77,7 @@ class WindowDocks:
         self.surface_panel.message.connect(self.log)
         self.editor.selection_changed.connect(self.surface_panel.set_selected)
         self.evaluation_finished.connect(self.surface_panel.set_report)
-        self.implicit_panel = ImplicitPanel(self.doc, self.undo, self)
+        self.implicit_panel = ImplicitPanel(self.doc, self.undo, self, prompter=self.prompter)
         self.implicit_dock = self._dock("Implicit Media", self.implicit_panel)
         self.implicit_panel.message.connect(self.log)
         self.editor.selection_changed.connect(self.implicit_panel.set_selected)

@@ -20,7 +20,7 @@ from engine.graph.schema import Param
 from engine.implicit.reconstruct import ALGORITHMS, FitResult, ParamSpace, fit
 from engine.implicit.values import SDF, as_points
 
-__all__ = ["NodeFit", "FIT_PARAMS", "fit_param", "parse_bounds"]
+__all__ = ["NodeFit", "FIT_PARAMS", "fit_param", "parse_bounds", "load_any_exemplar"]
 
 FIT_PARAMS = (
     Param("algorithm", "enum", "cmaes", choices=tuple(ALGORITHMS),
@@ -36,6 +36,41 @@ DEFAULT_SPREAD = 0.5        # default bounds: the current value +- half of it, w
 
 def fit_param(name: str) -> Param:
     return next(p for p in FIT_PARAMS if p.name == name)
+
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
+
+
+def load_any_exemplar(path) -> tuple:
+    """(exemplar, is an image): a 3D grid (`engine.implicit.exemplar.load_exemplar`: .npy, .vti,
+    a .tif stack) or a picture for analysis by synthesis (`engine.gpu.image_fit.load_image_exemplar`:
+    .png, .jpg, .bmp, a one-page .tif).
+
+    Raises
+    ------
+    ValueError
+        Naming the file and what was wrong with it.
+    """
+    from pathlib import Path
+
+    from engine.gpu.image_fit import load_image_exemplar
+    from engine.implicit.exemplar import load_exemplar
+
+    suffix = Path(str(path)).suffix.lower()
+    try:
+        if suffix in IMAGE_SUFFIXES:
+            return load_image_exemplar(path), True
+        try:
+            return load_exemplar(path), False
+        except ValueError as grid_error:
+            if suffix not in (".tif", ".tiff"):
+                raise
+            try:
+                return load_image_exemplar(path), True
+            except ValueError:
+                raise grid_error from None
+    except OSError as exc:
+        raise ValueError(f"{path}: {exc.strerror or exc}") from None
 
 
 def parse_bounds(text: str) -> tuple[str, float, float]:
@@ -133,6 +168,16 @@ class NodeFit:
         """The node's current values of the fitted parameters, clipped into their bounds."""
         return np.array([min(max(float(self.params.get(n, self.cls.param(n).default)), lo), hi)
                          for n, (lo, hi) in self.bounds.items()])
+
+    def fit_image(self, target, camera, *, algorithm: str = "cmaes", budget: float = 30.0, max_evaluations: int = 0,
+                  seed: int = 0, bounds=None, progress=None, check=None) -> FitResult:
+        """Analysis by synthesis (paper 004, section 6.2): fit to an image `target` ((h, w) grey or
+        (h, w, 3 | 4), `engine.gpu.image_fit.load_image_exemplar`) rendering each candidate at
+        `camera` (sphere tracing, Lambert shading; rays clipped to `bounds`)."""
+        from engine.gpu.image_fit import fit_image
+
+        return fit_image(self.space, target, camera, algorithm, budget, x0=self.start(), seed=seed, bounds=bounds,
+                         max_evaluations=max_evaluations or None, progress=progress, check=check)
 
     def fit(self, exemplar, *, algorithm: str = "cmaes", budget: float = 30.0, max_evaluations: int = 0,
             seed: int = 0, loss: str = "fourier", progress=None, check=None) -> FitResult:

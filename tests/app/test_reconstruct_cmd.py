@@ -91,3 +91,18 @@ def test_an_exemplar_of_the_wrong_shape_is_refused(tmp_path, capsys):
     np.save(tmp_path / "flat.npy", np.zeros((8, 8)))
     code, out, err = _cli(capsys, "reconstruct", graph, "--node", "g", "--exemplar", tmp_path / "flat.npy")
     assert code == 2 and "--exemplar" in err
+
+
+def test_an_image_exemplar_is_fitted_by_rendering_at_the_same_view(tmp_path, capsys):
+    truth = _project(tmp_path / "truth.json", cell=0.31, level=0.1)
+    guess = _project(tmp_path / "guess.json", cell=0.4, level=0.1)
+    png = tmp_path / "target.png"
+    code, out, err = _cli(capsys, "sdf", truth, "--render", png, "--size", "48x48", "--step", "fixed", "--json")
+    assert code == 0, err
+    camera = json.loads(out)["camera"]
+    code, out, err = _cli(capsys, "reconstruct", guess, "--node", "g", "--exemplar", png, "--fit", "cell=0.2:0.6",
+                          "--algorithm", "powell", "--max-evaluations", 80, "--json")
+    assert code == 0, err
+    info = json.loads(out)
+    assert info["exemplar"] == "image" and info["camera"] == camera      # the sdf command's framing
+    assert info["params"]["cell"] == pytest.approx(0.31, rel=0.02)

@@ -26,7 +26,7 @@ class FakePrompter:
     def error(self, title, text):
         self.errors.append((title, text))
 
-    def open_path(self, caption, directory=""):
+    def open_path(self, caption, directory="", filters=""):
         return self.open_answer
 
     def save_path(self, caption, directory="", filters=""):

@@ -90,3 +90,43 @@ def test_particles_histogram_counts_the_clouds_own_particles_and_paths_land(wind
 def test_a_graph_without_sdf_nodes_says_how_to_add_one(window):
     panel = window.implicit_panel
     assert panel.node_id is None and "Particles" in panel.title.text()
+
+
+def test_a_fit_to_a_grid_exemplar_is_applied_as_one_undo_step(window, qtbot, wait_eval, tmp_path):
+    import json
+
+    from engine.implicit.periodic import Periodic
+    from engine.implicit.voxelize import grid_nodes, sample_nodes
+
+    truth = Periodic("gyroid", cell=0.31, level=0.0)
+    origin, spacing, counts = grid_nodes((0, 0, 0), (1, 1, 1), 24, periodic=True)
+    np.save(tmp_path / "ex.npy", sample_nodes(truth, origin, spacing, counts).astype(np.float64))
+    (tmp_path / "ex.json").write_text(json.dumps({"spacing": list(spacing), "origin": [0, 0, 0]}))
+    (gid,) = _add(window, wait_eval, ("PeriodicFunction", {"kind": "gyroid", "cell": 0.4, "level_by": "level",
+                                                           "level": 0.0}))
+    panel = window.implicit_panel
+    window.editor.select(gid)
+    box = panel.fit_box
+    box.path_edit.setText(str(tmp_path / "ex.npy"))
+    box.bounds_edit.setText("cell=0.2:0.6")
+    box.algorithm_box.setCurrentIndex(box.algorithm_box.findData("powell"))
+    box.budget_box.setValue(20.0)
+    box.loss_box.setCurrentIndex(box.loss_box.findData("mse"))
+    assert box.start()
+    qtbot.waitUntil(lambda: box.result is not None and not box.runner.is_busy, timeout=60000)
+    assert box.result.params[0] == pytest.approx(0.31, rel=0.01)
+    assert window.doc.nodes[gid].params["cell"] == 0.4              # nothing changed until Apply
+    assert box.apply()
+    assert window.doc.nodes[gid].params["cell"] == pytest.approx(box.result.params[0])
+    window.undo.undo()
+    assert window.doc.nodes[gid].params["cell"] == 0.4
+
+
+def test_a_bad_exemplar_is_refused_at_the_box(window, wait_eval, tmp_path):
+    (gid,) = _add(window, wait_eval, ("PeriodicFunction", {}))
+    panel = window.implicit_panel
+    window.editor.select(gid)
+    np.save(tmp_path / "flat.npy", np.zeros((8, 8)))
+    panel.fit_box.path_edit.setText(str(tmp_path / "flat.npy"))
+    assert not panel.fit_box.start()
+    assert "flat.npy" in panel.fit_box.status.text()
