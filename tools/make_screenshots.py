@@ -35,6 +35,7 @@ SHOTS = (
     ("reaction_diffusion.png", "rd_cantilever", "Reaction Diffusion", 1, "RDGrow"),
     ("material_sphere.png", "octet_stiffness", "Inspector", 1, "MaterialMatrix"),
     ("surfaces.png", "tpms_gyroid", "Surfaces", 1, "Surface"),
+    ("implicit_media.png", "implicit_suspension_octet", "Implicit Media", 1, "SDFBoolean"),
 )
 
 
@@ -144,6 +145,8 @@ def main(argv=None) -> int:
         window.act_tiling.setChecked(tiles == 3)
         window.viewport.reset_camera()
         wait(app, lambda: window.viewport.is_ready, 300)
+        panel = window.implicit_panel
+        wait(app, lambda: panel.view.frames_shown > 0 and not panel.traces.is_busy or panel.node_id is None, 300)
         settle(app, 1200)
         written.append(save(grab(window), args.out / name))
     for p in written:
