@@ -55,6 +55,26 @@ def schema_value(flag: str, value, type_name: str, param: str, *, as_typed=None)
         raise FlagError(flag, value if as_typed is None else as_typed, reason, p.allowed()) from None
 
 
+def setting_value(flag: str, text, param):
+    """The text typed for a setting that is not a node parameter (a preview or fit setting
+    declared as a `Param` in the engine), read as its kind and coerced by it; FlagError naming
+    the flag and the allowed range."""
+    from engine.graph import ParamError
+
+    value = text
+    if param.kind in ("int", "float") and isinstance(text, str):
+        s = text.strip()
+        try:
+            value = int(s) if param.kind == "int" and s.lstrip("+-").isdigit() else float(s)
+        except ValueError:
+            raise FlagError(flag, text, "not a number", param.allowed()) from None
+    try:
+        return param.coerce(value)
+    except ParamError as exc:
+        reason = "out of range" if exc.expected.startswith("a value in") else f"expected {exc.expected}"
+        raise FlagError(flag, text, reason, param.allowed()) from None
+
+
 def memory_value(flag: str, value, need: int, *, lower: str = "") -> int:
     """Refuse ``need`` bytes over the memory budget as a FlagError naming the flag."""
     try:

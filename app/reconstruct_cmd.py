@@ -50,22 +50,10 @@ def add_parsers(sub) -> None:
 
 
 def _setting(flag, text, name):
-    from app.flags import FlagError
-    from engine.graph import ParamError
+    from app.flags import setting_value
     from engine.nodes.sdf_fit import fit_param
 
-    p = fit_param(name)
-    value = text
-    if p.kind in ("int", "float"):
-        try:
-            value = int(text) if p.kind == "int" and str(text).strip().lstrip("+-").isdigit() else float(text)
-        except ValueError:
-            raise FlagError(flag, text, "not a number", p.allowed()) from None
-    try:
-        return p.coerce(value)
-    except ParamError as exc:
-        raise FlagError(flag, text, "out of range" if exc.expected.startswith("a value in") else
-                        f"expected {exc.expected}", p.allowed()) from None
+    return setting_value(flag, text, fit_param(name))
 
 
 def _check(args):

@@ -59,17 +59,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--json", action="store_true", help="print a JSON summary")
 
 
-def _number(flag, text, name, *, as_int=True):
-    from app.flags import FlagError
-    from engine.graph import ParamError
+def _number(flag, text, name):
+    from app.flags import setting_value
     from engine.nodes.sdf_preview import preview_param
 
-    param = preview_param(name)
-    try:
-        return param.coerce(int(text) if as_int and str(text).strip().lstrip("+-").isdigit() else float(text))
-    except (ValueError, ParamError):
-        raise FlagError(flag, text, "out of range" if str(text).strip().lstrip("+-").replace(".", "").isdigit()
-                        else "not a number", param.allowed()) from None
+    return setting_value(flag, text, preview_param(name))
 
 
 def _size(text):

@@ -56,7 +56,8 @@ import numpy as np
 from engine.gpu._sphere_trace_glsl import CLIP_GLSL, GRADIENT_GLSL, MARCH_GLSL
 from engine.gpu.camera import CAMERA_GLSL, Camera
 from engine.gpu.context import gpu_session
-from engine.gpu.sphere_trace import _bind_textures, _box, _count, _length, _program, _real
+from engine.gpu.shader_cache import bind_textures, compute_program
+from engine.gpu.sphere_trace import _box, _count, _length, _real
 from engine.implicit.values import SDF, GlslModule
 
 __all__ = ["path_trace", "PathTraceResult", "depth_study", "DepthStudy", "MATERIALS", "SKY", "tonemap"]
@@ -387,8 +388,8 @@ def path_trace(sdf: SDF, camera: Camera, width: int, height: int, *, frames: int
     with gpu_session() as ctx:
         owned = []
         try:
-            prog = _program(ctx, source)
-            _bind_textures(ctx, prog, module.textures, owned)
+            prog = compute_program(ctx, source)
+            bind_textures(ctx, prog, module.textures, owned)
             for name, value in uniforms.items():
                 if name in prog:
                     prog[name].value = value

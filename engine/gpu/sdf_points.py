@@ -27,12 +27,11 @@ caller's progress is told and may cancel), and writes ``f / lipschitz``.
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
 
 import numpy as np
 
 from engine.gpu.context import gpu_session
+from engine.gpu.shader_cache import bind_textures, compute_program
 from engine.implicit.values import SDF, GlslModule, as_points
 
 from engine.progress import report
@@ -42,9 +41,6 @@ __all__ = ["evaluate_glsl", "evaluate_glsl_grid", "compute_source", "grid_source
 
 GROUP_SIZE = 64
 CHUNK_POINTS = GROUP_SIZE * 16384   # 1 M points per dispatch
-_CACHE_SIZE = 16                     # compiled programs kept (per source text)
-_PROGRAMS: "OrderedDict[tuple, object]" = OrderedDict()
-_PROGRAMS_LOCK = threading.Lock()
 
 _TEMPLATE = """#version 430
 layout(local_size_x = {group}) in;
@@ -109,36 +105,6 @@ def compute_source(module: GlslModule, entry: str) -> str:
     return _TEMPLATE.format(group=GROUP_SIZE, library=module.source(), entry=entry)
 
 
-def _program(ctx, source: str):
-    key = (id(ctx), source)
-    with _PROGRAMS_LOCK:
-        prog = _PROGRAMS.get(key)
-        if prog is None:
-            prog = ctx.compute_shader(source)
-            _PROGRAMS[key] = prog
-            while len(_PROGRAMS) > _CACHE_SIZE:
-                _, old = _PROGRAMS.popitem(last=False)
-                old.release()
-        else:
-            _PROGRAMS.move_to_end(key)
-        return prog
-
-
-def _upload_textures(ctx, prog, textures: dict, owned: list) -> None:
-    for unit, (name, data) in enumerate(textures.items()):
-        arr = np.ascontiguousarray(data, dtype=np.float32)
-        if arr.ndim != 3 or min(arr.shape) < 1:
-            raise ValueError(f"texture {name!r}: expected a (nz, ny, nx) array, got shape {arr.shape}")
-        nz, ny, nx = arr.shape
-        tex = ctx.texture3d((nx, ny, nz), 1, arr.tobytes(), dtype="f4")
-        owned.append(tex)
-        tex.filter = (ctx.LINEAR, ctx.LINEAR)
-        tex.repeat_x = tex.repeat_y = tex.repeat_z = True
-        tex.use(location=unit)
-        if name in prog:            # the compiler drops samplers the tree does not read
-            prog[name].value = unit
-
-
 def evaluate_glsl(sdf: SDF, points) -> np.ndarray:
     """f of `sdf` at `points`, computed by its GLSL on the headless GPU context.
 
@@ -176,8 +142,8 @@ def evaluate_glsl(sdf: SDF, points) -> np.ndarray:
     with gpu_session() as ctx:
         owned = []
         try:
-            prog = _program(ctx, source)
-            _upload_textures(ctx, prog, module.textures, owned)
+            prog = compute_program(ctx, source)
+            bind_textures(ctx, prog, module.textures, owned)
             pts = ctx.buffer(p.astype(np.float32).tobytes())
             owned.append(pts)
             out = ctx.buffer(reserve=4 * n)
@@ -239,8 +205,8 @@ def evaluate_glsl_grid(sdf: SDF, origin, spacing, shape, *, progress=None) -> np
     with gpu_session() as ctx:
         owned = []
         try:
-            prog = _program(ctx, source)
-            _upload_textures(ctx, prog, module.textures, owned)
+            prog = compute_program(ctx, source)
+            bind_textures(ctx, prog, module.textures, owned)
             buf = ctx.buffer(reserve=4 * min(planes, n[0]) * n[1] * n[2])
             owned.append(buf)
             buf.bind_to_storage_buffer(1)

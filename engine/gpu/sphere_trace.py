@@ -76,9 +76,7 @@ between two ``glFinish``.
 from __future__ import annotations
 
 import math
-import threading
 import time
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,6 +84,7 @@ import numpy as np
 from engine.gpu._sphere_trace_glsl import CLIP_GLSL, GRADIENT_GLSL, MARCH_GLSL, TRACE_TEMPLATE
 from engine.gpu.camera import CAMERA_GLSL, Camera
 from engine.gpu.context import gpu_session
+from engine.gpu.shader_cache import bind_textures, compute_program
 from engine.implicit.values import SDF, GlslModule
 
 __all__ = ["render", "TraceResult", "trace_source", "STEP_MODES", "SHADINGS", "TILE"]
@@ -96,9 +95,6 @@ TILE = 256                      # pixels per tile side (one dispatch, then check
 GROUP = 8                       # work group side
 AMBIENT = 0.1                   # Lambert: ambient share; the light is fixed in the camera frame
 _LIGHT_CAMERA = (-0.45, 0.6, -0.66)   # (right, up, forward) components of the light direction
-_CACHE_SIZE = 12
-_PROGRAMS: "OrderedDict[tuple, object]" = OrderedDict()
-_PROGRAMS_LOCK = threading.Lock()
 
 @dataclass(frozen=True, eq=False)
 class TraceResult:
@@ -162,32 +158,6 @@ def trace_source(module: GlslModule, entry: str, *, step: str, shading: str, cli
                                  clip=int(bool(clip)), group=GROUP, camera=CAMERA_GLSL,
                                  library=module.source(), entry=entry, ambient=repr(AMBIENT),
                                  clip_glsl=CLIP_GLSL, march_glsl=MARCH_GLSL, gradient_glsl=GRADIENT_GLSL)
-
-
-def _program(ctx, source: str):
-    key = (id(ctx), source)
-    with _PROGRAMS_LOCK:
-        prog = _PROGRAMS.pop(key, None)
-        if prog is None:
-            prog = ctx.compute_shader(source)
-        _PROGRAMS[key] = prog
-        while len(_PROGRAMS) > _CACHE_SIZE:
-            _PROGRAMS.popitem(last=False)[1].release()
-        return prog
-
-
-def _bind_textures(ctx, prog, textures: dict, owned: list) -> None:
-    for unit, (name, data) in enumerate(textures.items()):
-        arr = np.ascontiguousarray(data, dtype=np.float32)
-        if arr.ndim != 3 or min(arr.shape) < 1:
-            raise ValueError(f"texture {name!r}: expected a (nz, ny, nx) array, got shape {arr.shape}")
-        tex = ctx.texture3d(arr.shape[::-1], 1, arr.tobytes(), dtype="f4")
-        owned.append(tex)
-        tex.filter = (ctx.LINEAR, ctx.LINEAR)
-        tex.repeat_x = tex.repeat_y = tex.repeat_z = True
-        tex.use(location=unit)
-        if name in prog:            # the compiler drops samplers the tree does not read
-            prog[name].value = unit
 
 
 def _real(name: str, value, ok, expected: str) -> float:
@@ -316,8 +286,8 @@ def render(sdf: SDF, camera: Camera, width: int, height: int, *, step: str = "fi
     with gpu_session() as ctx:
         owned = []
         try:
-            prog = _program(ctx, source)
-            _bind_textures(ctx, prog, module.textures, owned)
+            prog = compute_program(ctx, source)
+            bind_textures(ctx, prog, module.textures, owned)
             for name, value in uniforms.items():
                 if name in prog:
                     prog[name].value = value

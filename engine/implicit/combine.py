@@ -79,10 +79,12 @@ def _reduce_glsl(module: GlslModule, owner, parts, op: str) -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class Union(SDF):
-    """min of the parts' distances: inside any part."""
+class _Reduction(SDF):
+    """min (`Union`) or max (`Intersection`) of the parts' distances."""
 
     parts: tuple
+    _numpy = staticmethod(np.min)
+    _glsl_op = "min"
 
     def __post_init__(self):
         object.__setattr__(self, "parts", _check_parts(self.parts))
@@ -93,38 +95,31 @@ class Union(SDF):
 
     def field(self, points):
         p = as_points(points)
-        return np.min([c.distance(p) for c in self.parts], axis=0)
+        return type(self)._numpy([c.distance(p) for c in self.parts], axis=0)
+
+    def glsl(self, module):
+        return _reduce_glsl(module, self, self.parts, self._glsl_op)
+
+
+class Union(_Reduction):
+    """min of the parts' distances: inside any part."""
+
+    _numpy = staticmethod(np.min)
+    _glsl_op = "min"
 
     @property
     def exact(self):
         return all(c.exact for c in self.parts)
 
-    def glsl(self, module):
-        return _reduce_glsl(module, self, self.parts, "min")
-
     def box(self):
         return _union_box([c.box() for c in self.parts])
 
 
-@dataclass(frozen=True, eq=False)
-class Intersection(SDF):
+class Intersection(_Reduction):
     """max of the parts' distances: inside every part."""
 
-    parts: tuple
-
-    def __post_init__(self):
-        object.__setattr__(self, "parts", _check_parts(self.parts))
-
-    @property
-    def children(self):
-        return self.parts
-
-    def field(self, points):
-        p = as_points(points)
-        return np.max([c.distance(p) for c in self.parts], axis=0)
-
-    def glsl(self, module):
-        return _reduce_glsl(module, self, self.parts, "max")
+    _numpy = staticmethod(np.max)
+    _glsl_op = "max"
 
     def box(self):
         return _intersect_box([c.box() for c in self.parts])
