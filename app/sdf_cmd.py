@@ -132,16 +132,13 @@ def _check(args):
     plan = {}
     if args.render is not None:
         plan["png"] = output_path("--render", args.render, (".png",))
-        plan["size"] = _size(args.size) if args.size else (512, 512)
-        from engine.gpu.sphere_trace import STEP_MODES
-        step = args.step or "adaptive"
-        if step not in STEP_MODES:
-            raise FlagError("--step", step, "unknown step rule", "one of " + ", ".join(STEP_MODES))
-        plan["step"] = step
-        for flag, name, default in (("--adaptive-every", "adaptive_every", 100), ("--max-steps", "max_steps", 512),
-                                    ("--paths", "paths", 0), ("--max-depth", "max_depth", 8)):
+        from engine.nodes.sdf_preview import preview_param
+        plan["size"] = _size(args.size) if args.size else (preview_param("width").default,
+                                                           preview_param("height").default)
+        for flag, name in (("--step", "step"), ("--adaptive-every", "adaptive_every"), ("--max-steps", "max_steps"),
+                           ("--paths", "paths"), ("--max-depth", "max_depth")):
             text = getattr(args, name)
-            plan[name] = _number(flag, text, name) if text is not None else default
+            plan[name] = _number(flag, text, name) if text is not None else preview_param(name).default
         plan["view_box"] = _box(args.view_box) if args.view_box else None
         if args.camera:
             from engine.gpu.camera import parse_camera
@@ -169,6 +166,14 @@ def _check(args):
         if any(b <= a for a, b in zip(lo, hi)):
             raise FlagError("--box-to", ",".join(map(str, hi)), "not above --box-from on every axis",
                             "box_to > box_from")
+        from app.flags import memory_error
+        from engine.memory import MemoryLimitError
+        params = {p.name: p.default for p in node_type("SDFSolid").params}
+        params.update(plan["solid"], resolution=plan["resolution"])
+        try:
+            node_type("SDFSolid").check_memory(params)
+        except MemoryLimitError as exc:
+            raise memory_error("--voxels", args.voxels, exc) from None
     return doc, node, plan
 
 

@@ -10,7 +10,9 @@ from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.gpu.sdf_voxels import BACKENDS, sample_box
-from engine.implicit.voxelize import BYTES_PER_NODE, check_box, solid_from_samples
+from engine.implicit.voxelize import BYTES_PER_NODE, CHUNK_BYTES, SAMPLE_POINTS, check_box, solid_from_samples
+
+GPU_OVERHEAD = 64 * 2 ** 20     # bytes: the GPU path's read-back buffer and first plane blocks (measured ~50 MB)
 from engine.progress import stage
 
 from .implicit_common import built
@@ -70,7 +72,8 @@ class SDFSolidNode(NodeType):
             if np.all(b > a):
                 edges = b - a
         n = np.array(box_grid_shape(tuple(edges / edges.max()), params["resolution"])) + 1
-        return int(np.prod(n, dtype=np.int64)) * BYTES_PER_NODE
+        chunk = GPU_OVERHEAD if params.get("backend") == "gpu" else CHUNK_BYTES * SAMPLE_POINTS
+        return int(np.prod(n, dtype=np.int64)) * BYTES_PER_NODE + chunk
 
     def evaluate(self, inputs, params, ctx):
         sdf = inputs["sdf"]
