@@ -17,9 +17,9 @@ on screen, the number of copies and whether the camera is moving:
   large cell framed whole draws a decimated mesh, and zooming in until the
   deviation would show brings the full mesh back;
 * within budget: the copies in view together draw at most `STILL_BUDGET`
-  triangles (or one full cell, if that is more; a single cell in view is
-  exempt: its full mesh is always allowed) or, while the camera moves,
-  `MOVING_BUDGET`;
+  triangles (a single cell in view is exempt: its full mesh is always
+  allowed, and the deviation rule keeps it to what shows) or, while the
+  camera moves, `MOVING_BUDGET`;
 * a translucent solid (drawn faint behind the skeleton it was made from)
   keeps to `MOVING_BUDGET` even when still: its facets cannot be told apart
   through the blending, and a blended frame costs more per triangle.
@@ -46,7 +46,7 @@ from engine.geometry.mesh_deviation import mesh_deviation
 
 from .scene_prep import PreparedCell, prepare_cell
 
-STILL_BUDGET = 120_000        # triangles a still tiled view draws at most (~100 ms a frame on llvmpipe)
+STILL_BUDGET = 84_000         # triangles a still tiled view draws at most (~85 ms a frame on llvmpipe)
 MOVING_BUDGET = 40_000        # triangles drawn while the camera moves (>= 10 frames/s)
 TRIANGLES_PER_PIXEL = 1.0     # detail wanted: triangles per pixel of the cell's projected square
 STILL_ERROR_PIXELS = 0.5      # a still single cell draws the coarsest level deviating less than this on screen
@@ -136,7 +136,7 @@ def pick_level(counts: Sequence[int], copies: int, cell_pixels: float, moving: b
     if moving or translucent:
         budget = MOVING_BUDGET
     else:
-        budget = math.inf if copies == 1 else max(STILL_BUDGET, max(counts))
+        budget = math.inf if copies == 1 else STILL_BUDGET
     allowed = [i for i in order if copies * counts[i] <= budget and counts[i] <= counts[enough]]
     if allowed:
         return allowed[-1], True

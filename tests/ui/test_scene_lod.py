@@ -18,14 +18,14 @@ from ui.scene_lod import (MOVING_BUDGET, SINGLE_FRAME_BUDGET, STILL_BUDGET, STIL
                           surface_deviation)
 from ui.scene_prep import prepare_cell
 
-LEVELS = [123_248, 40_000, 15_000, 4_444, 1_481]       # the octet cell's ladder (build order)
+LEVELS = [123_248, 40_000, 10_500, 3_111, 1_481]       # the octet cell's ladder (build order)
 
 
 def test_ladder_targets_what_each_view_can_afford():
     assert level_targets(123_248) == LEVELS
-    assert level_targets(5_000) == [5_000, 1_481]              # 4 444 is not clearly coarser than 5 000
+    assert level_targets(3_500) == [3_500, 1_481]              # 3 111 is not clearly coarser than 3 500
     assert level_targets(300) == [300]                         # too small to decimate
-    assert level_targets(2_000_000) == [2_000_000, 40_000, 15_000, 4_444, 1_481]
+    assert level_targets(2_000_000) == [2_000_000, 40_000, 10_500, 3_111, 1_481]
 
 
 def test_a_still_single_cell_draws_the_coarsest_level_no_pixel_can_tell_apart():
@@ -97,9 +97,9 @@ def test_moving_views_keep_to_the_moving_budget():
 
 def test_a_still_tiled_view_gets_the_finest_level_the_budget_allows():
     i, fits = pick_level(LEVELS, 27, 170, moving=False)
-    assert fits and LEVELS[i] == 4_444 and 27 * LEVELS[i] <= STILL_BUDGET
+    assert fits and LEVELS[i] == 3_111 and 27 * LEVELS[i] <= STILL_BUDGET
     i, _ = pick_level(LEVELS, 8, 600, moving=False)             # close: 8 tiles in view get finer tiles
-    assert LEVELS[i] == 15_000
+    assert LEVELS[i] == 10_500
     i, _ = pick_level(LEVELS, 27, 10, moving=False)             # far away: enough detail is little
     assert LEVELS[i] == 1_481 >= TRIANGLES_PER_PIXEL * 10 ** 2
 
@@ -114,7 +114,7 @@ def test_a_translucent_solid_keeps_to_the_moving_budget_when_still():
 
 def test_nothing_fits_until_a_coarse_level_exists():
     assert pick_level([123_248], 27, 170, moving=False) == (0, False)
-    assert pick_level([123_248, 4_444], 27, 170, moving=False) == (1, True)
+    assert pick_level([123_248, 3_111], 27, 170, moving=False) == (1, True)
 
 
 def test_pixels_per_mm_of_a_perspective_and_a_parallel_camera():
