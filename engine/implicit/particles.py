@@ -4,8 +4,14 @@ Space is cut into cubic cells of width w (mm); cell c = (i, j, k) covers
 ``[c w, (c + 1) w]``.  Each cell draws uniforms u_0 .. u_8 from the hash of
 its index and the seed (`cell_hash`), the same numbers in numpy and GLSL:
 
-* u_0: Russian roulette, the particle exists iff ``u_0 < density`` (density
-  taken at the cell centre, constant or a linear ramp along an axis);
+* u_0: Russian roulette, the particle exists iff ``u_0 < density`` (the
+  keep probability, taken at the cell centre: constant or a linear ramp along
+  an axis, times an optional `density_field` sampled there), and the cell is
+  one an optional congruence `rule` keeps (particle correlation by rejection,
+  supplementary 10.2: e.g. `particle_fields.clusters`; the checks of both
+  fields and the rule live in `particle_fields`).  The GLSL twin forms the
+  probability in float32, so a cell whose u_0 lies within float32 rounding
+  of it may differ between numpy and the GPU (the ramp's too);
 * u_1, u_2: the size s (mm) from a `SizeDistribution`, clamped to
   ``[0, s_max]`` where ``s_max * bound = w / 2`` (bound: the unit shape's
   bounding radius); a size of 0 gives no particle;
@@ -19,18 +25,33 @@ scaled by s and rotated.  A point x (after the optional warp
 w / 2); its 2 x 2 x 2 block of nearest cells, from ``floor(x / w - 0.5)``,
 are the only ones whose particles can reach it (eq. 4).  The field is
 
-    f(x) = min( min over the block's particles of d_i(x),  b(x) ) - offset,
+    f(x) = min( min over the block's particles of d_i(x),  b(x) ) - offset - o(x),
 
-with b(x) the distance from x to the outside of the block, at least w / 2.
-Why b: every particle outside the block lies in its own cell, outside the
+with b(x) the distance from x to the outside of the block, at least w / 2,
+and o an optional `offset_field` (eq. 6's spatially varying offset).  Why
+b: every particle outside the block lies in its own cell, outside the
 block, so it is at least b(x) away; hence min(g, b) <= the distance to the
 union of all particles (a lower bound, exact wherever that distance is at
 most w / 2 and inside particles), it stays finite where the block's cells
 are empty, and it is continuous across dual-cell faces (there b = w / 2 and
-the particles that leave or enter the block are at least w / 2 away).  A
-min of 1-Lipschitz functions, it is 1-Lipschitz; the warp multiplies the
-bound by ``1 + a f``.  The offset must stay below w / 2 so that b - offset
-never creates material away from the particles.
+the particles that leave or enter the block are at least w / 2 away).  The
+argument only needs each particle inside its own cell, not which cells are
+kept: the roulette, the density field and the rule all decide per cell (the
+field read at the cell centre, never at x), so a particle is whole or
+absent and the bound, its exactness and continuity hold for any kept set.
+A min of 1-Lipschitz functions, min(g, b) is 1-Lipschitz (L_s for a
+non-Euclidean shape); o, trilinear in its samples, has ``|grad o| <= L_o``
+(`field_sampling`: ``sqrt(Dx^2 + Dy^2 + Dz^2) <= sqrt(3) max_a Da``, Da the
+largest sample difference along axis a over the spacing), so f is
+``(L_s + L_o)``-Lipschitz in x; the warp multiplies the bound by
+``1 + a f``.  The total offset ``offset + o(x)`` must stay below w / 2
+everywhere (o never exceeds its largest sample) so that b - offset - o > 0:
+the guard never creates material away from the particles; then, where
+f <= 0, min(g, b) < w / 2 <= b, so f is the particles' own distance minus
+the offset and (exact shapes) the solid is ``{x : dist(x, particles) <=
+offset + o(x)}``.  There is no lower limit on ``offset + o``: where it is
+at most -w / 2 no particle remains (a particle's inner radius is at most its
+bounding radius, at most w / 2).  Both fields live in the particles' frame x.
 """
 
 from __future__ import annotations
@@ -42,6 +63,9 @@ from typing import NamedTuple
 import numpy as np
 
 from . import cell_hash
+from .congruence import CombinedRule, CongruenceRule
+from .field_sampling import GridField
+from .particle_fields import check_density_field, check_offset_field, check_rule
 from .shapes import check_shape_params, shape_glsl, shape_spec
 from .values import SDF, as_points, glsl_float
 
@@ -184,7 +208,14 @@ class Suspension(SDF):
         `density_end` (in [0, 1]) it ramps linearly from `density` at coordinate
         ``density_span[0]`` to `density_end` at ``density_span[1]`` (mm, start < end)
         along axis `density_axis` (0, 1, 2), constant beyond.
+    density_field : GridField (or a Field-like with values, lo, hi; samples in [0, 1]) or
+        None: multiplies the keep probability, read at each cell's centre ``w (c + 0.5)``.
+    rule : CongruenceRule, CombinedRule or None: only the cells it keeps may hold a
+        particle (correlation by rejection; e.g. `particle_fields.clusters`).
     offset : float, mm (< w / 2), moves every surface outwards.
+    offset_field : GridField (or a Field-like, mm) or None: added to `offset` at x; the
+        total ``offset + max(offset_field)`` must stay < w / 2 (no lower limit: where
+        ``offset + o(x) <= -w / 2`` no particle remains).
     warp_amplitude : float, mm (>= 0); warp_frequency : float, rad / mm (>= 0).
     seed : int.
 
@@ -205,7 +236,10 @@ class Suspension(SDF):
     density_end: float | None = None
     density_axis: int = 2
     density_span: tuple = (0.0, 1.0)
+    density_field: GridField | None = None
+    rule: CongruenceRule | CombinedRule | None = None
     offset: float = 0.0
+    offset_field: GridField | None = None
     warp_amplitude: float = 0.0
     warp_frequency: float = 0.0
     seed: int = 0
@@ -243,6 +277,9 @@ class Suspension(SDF):
                                    ("warp_amplitude", math.inf, False, 0.0),
                                    ("warp_frequency", math.inf, False, 0.0)):
             object.__setattr__(self, k, _finite(k, getattr(self, k), lo, hi, hi_open=hi_open))
+        object.__setattr__(self, "density_field", check_density_field(self.density_field))
+        object.__setattr__(self, "offset_field", check_offset_field(self.offset_field, self.offset, w))
+        check_rule(self.rule)
         word = cell_hash.seed_word(self.seed)
         for k, v in (("cell", w), ("proportions", props), ("_bound", bound), ("_smax", smax),
                      ("_word", word)):
@@ -250,16 +287,23 @@ class Suspension(SDF):
 
     @property
     def lipschitz(self):
-        return shape_spec(self.shape).lipschitz * (1.0 + self.warp_amplitude * self.warp_frequency)
+        """(L_s + L_o) (1 + a f): the shape's bound plus the offset field's, times the warp's."""
+        l_o = 0.0 if self.offset_field is None else self.offset_field.lipschitz
+        return (shape_spec(self.shape).lipschitz + l_o) * (1.0 + self.warp_amplitude * self.warp_frequency)
 
     # -- the particles of given cells -------------------------------------------------
 
     def _density_of(self, cells: np.ndarray):
+        """The keep probability of each cell ((m, 3) int): scalar or (m,) float64."""
         if self.density_end is None:
-            return float(self.density)
-        s0, s1 = (float(v) for v in self.density_span)
-        t = np.clip(((cells[:, self.density_axis] + 0.5) * self.cell - s0) / (s1 - s0), 0.0, 1.0)
-        return self.density * (1.0 - t) + self.density_end * t
+            p = float(self.density)
+        else:
+            s0, s1 = (float(v) for v in self.density_span)
+            t = np.clip(((cells[:, self.density_axis] + 0.5) * self.cell - s0) / (s1 - s0), 0.0, 1.0)
+            p = self.density * (1.0 - t) + self.density_end * t
+        if self.density_field is not None:
+            p = p * self.density_field.sample(self.cell * (cells + 0.5))
+        return p
 
     def _particles(self, cells: np.ndarray):
         """keep (m,) bool, sizes (m,), centres (m, 3), rotations (m, 3, 3) or None."""
@@ -269,6 +313,8 @@ class Suspension(SDF):
             return cell_hash.cell_uniform(stream, r)
         s = np.clip(self.size.sample(u(1), u(2)), 0.0, self._smax)
         keep = (u(0) < self._density_of(cells)) & (s > 0.0)
+        if self.rule is not None:
+            keep &= self.rule.keep(cells)
         jit = np.stack([u(3), u(4), u(5)], axis=1)
         shrink = 1.0 - 2.0 * s * self._bound / self.cell
         centres = self.cell * (cells + 0.5 + self.jitter * (jit - 0.5) * shrink[:, None])
@@ -326,6 +372,8 @@ class Suspension(SDF):
             s = np.where(keep, s, 1.0)
             d = spec.fn(q, *(s * v for v in self.proportions))
             best = np.minimum(best, np.where(keep, d, np.inf))
+        if self.offset_field is not None:
+            best = best - self.offset_field.sample(x)
         return best - self.offset
 
     def glsl(self, module):
@@ -342,6 +390,13 @@ class Suspension(SDF):
             ax = "xyz"[self.density_axis]
             dens = (f"mix({glsl_float(self.density)}, {glsl_float(self.density_end)}, clamp(("
                     f"(float(cell.{ax}) + 0.5) * {w} - {glsl_float(s0)}) / {glsl_float(s1 - s0)}, 0.0, 1.0))")
+        # every helper is defined before the cloud's own function (dependencies first)
+        if self.density_field is not None:
+            dens = f"{dens} * {self.density_field.glsl(module)}({w} * (vec3(cell) + 0.5))"
+        ruled = "" if self.rule is None else f"if (!{self.rule.glsl(module)}(cell)) continue;"
+        offset = glsl_float(self.offset)
+        if self.offset_field is not None:
+            offset = f"{offset} + {self.offset_field.glsl(module)}(x)"
         x = "p"
         if self.warp_amplitude != 0.0:
             x = (f"p + {glsl_float(self.warp_amplitude)} * "
@@ -362,6 +417,7 @@ class Suspension(SDF):
     ivec3 ib = ivec3(base);
     for (int c = 0; c < 8; ++c) {{
         ivec3 cell = ib + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        {ruled}
         uint st = mf_cell_stream(cell, {self._word}u);
         float s = clamp({size}, 0.0, {glsl_float(self._smax)});
         if (!({u(0)} < {dens}) || !(s > 0.0)) continue;
@@ -371,6 +427,6 @@ class Suspension(SDF):
         {rotate}
         best = min(best, {helper}(q, {args}));
     }}
-    return best - {glsl_float(self.offset)};
+    return best - ({offset});
 }}"""
         return module.function(self, make)

@@ -11,38 +11,9 @@ from engine.implicit.agglomerate import Agglomerate
 from engine.implicit.piling import Pile
 from engine.implicit.shapes import SHAPES
 
-from .implicit_common import built
-from .implicit_media import AXES
+from .implicit_common import AXES, built, make_rule, polynomial, rule_json
 
 STRUCTURES = ("all", "fibres", "laminates", "porous", "cubic frame", "gel", "rule")
-
-
-def _polynomial(data):
-    """JSON ``[[a, [ex, ey, ez]], ...]`` as the kernel's tuple of monomials."""
-    return tuple((int(a), tuple(int(e) for e in ex)) for a, ex in data)
-
-
-def _rule_json(data):
-    """A congruence rule as JSON: ``{"polynomials": [[[a, [ex, ey, ez]], ...], ...],
-    "moduli": [m or null, ...], "classes": [[[value, sign], ...], ...], "inner": "or",
-    "outer": "or"}``; checked by building it (ValueError names what is wrong)."""
-    if data is None:
-        return None
-    if not isinstance(data, dict):
-        raise ValueError("expected an object with polynomials, moduli and classes")
-    try:
-        rule = _make_rule(data)
-    except (TypeError, KeyError) as exc:
-        raise ValueError(f"expected polynomials, moduli and classes lists ({exc})") from None
-    return data if rule is not None else None
-
-
-def _make_rule(data):
-    return congruence.CongruenceRule(
-        tuple(_polynomial(p) for p in data["polynomials"]),
-        tuple(None if m is None else int(m) for m in data["moduli"]),
-        tuple(tuple((int(v), int(s)) for v, s in c) for c in data["classes"]),
-        inner=data.get("inner", "or"), outer=data.get("outer", "or"))
 
 
 def structure_rule(params):
@@ -54,7 +25,7 @@ def structure_rule(params):
             "porous": lambda: congruence.porous(period, width),
             "cubic frame": lambda: congruence.cubic_frame(period, width),
             "gel": lambda: congruence.bezier_gel(period=period, width=width),
-            "rule": lambda: _make_rule(params["rule"]) if params["rule"] else None}[s]()
+            "rule": lambda: make_rule(params["rule"]) if params["rule"] else None}[s]()
 
 
 @register
@@ -78,7 +49,7 @@ class AgglomerateNode(NodeType):
         Param("period", "int", 4, 1, 46340, unit="cells", doc="modulus of the structure's rule"),
         Param("width", "int", 1, 1, 46340, unit="cells", doc="fibre / layer / pore width (< period)"),
         Param("axis", "enum", "z", choices=AXES, doc="fibre direction / layer normal"),
-        Param("rule", "json", None, doc=_rule_json.__doc__.split(":", 1)[1].strip(), check=_rule_json),
+        Param("rule", "json", None, doc=rule_json.__doc__.split(":", 1)[1].strip(), check=rule_json),
         Param("jitter", "float", 0.0, 0.0, 1.0, doc="random particle displacement within its bound"),
         Param("seed", "int", 1, 0, 2 ** 31 - 1, doc="seed of the jitter"),
     )
@@ -118,7 +89,7 @@ class PileNode(NodeType):
         Param("rotation_axis", "enum", "z", choices=AXES, doc="axis grains turn about"),
         Param("rotation_poly", "json", [[1, [1, 0, 0]], [2, [0, 1, 0]], [3, [0, 0, 1]]],
               doc="integer polynomial of the cell index [[a, [ex, ey, ez]], ...]: the turn is "
-                  "2 pi (value mod steps) / steps", check=lambda d: [list(m) for m in _polynomial(d)]),
+                  "2 pi (value mod steps) / steps", check=lambda d: [list(m) for m in polynomial(d)]),
         Param("rotation_steps", "int", 12, 1, 46340, doc="turns come in multiples of 2 pi / steps"),
         Param("deform", "vec3", [0.15, 0.0, 0.0], -1e4, 1e4,
               doc="c0, c1, c2 of the deformation amplitude P(s) = c0 + c1 s + c2 s^2 (mm; s along the "
@@ -136,7 +107,7 @@ class PileNode(NodeType):
                         concavity_end=params["concavity_end"] if params["graded"] else None,
                         concavity_axis=axis, concavity_span=(params["grade_from"], params["grade_to"]),
                         rotation_axis=AXES.index(params["rotation_axis"]),
-                        rotation_poly=_polynomial(params["rotation_poly"]), rotation_steps=params["rotation_steps"],
+                        rotation_poly=polynomial(params["rotation_poly"]), rotation_steps=params["rotation_steps"],
                         deform_poly=deform if any(deform) else (), deform_axis=axis,
                         deform_span=(params["grade_from"], params["grade_to"]),
                         noise_frequency=params["noise_frequency"], seed=params["seed"])

@@ -4,16 +4,43 @@ and the sphere tracer take."""
 
 from __future__ import annotations
 
+from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
+from engine.implicit.field_sampling import grid_field_from
+from engine.implicit.particle_fields import clusters
 from engine.implicit.particles import SizeDistribution, Suspension
 from engine.implicit.periodic import KINDS, VARIANTS, Periodic
 from engine.implicit.shapes import SHAPES
 from engine.implicit.volume_fraction import level_for_fraction
 
-from .implicit_common import built
+from .implicit_common import AXES, built, make_rule, rule_json
 
-AXES = ("x", "y", "z")
+CORRELATIONS = ("none", "clusters", "rule")
+
+
+def _correlation_rule(params):
+    """The cell rule of the node's `correlation` choice (None: no rejection by rule)."""
+    kind = params["correlation"]
+    if kind == "clusters":
+        return clusters(params["cluster_period"], params["cluster_size"])
+    if kind == "rule" and params["correlation_rule"]:
+        return make_rule(params["correlation_rule"])
+    return None
+
+
+def _grid_field(inputs, port, params):
+    """The optional Field on `port` as a GridField (a 2-D field extruded along field_axis)."""
+    f = inputs.get(port)
+    if f is None:
+        return None
+    if getattr(f, "kind", None) != "scalar":
+        raise NodeInputError(f"{port} needs a scalar Field, got a {getattr(f, 'kind', type(f).__name__)} one",
+                             where=port)
+    try:
+        return grid_field_from(f.values, f.lo, f.hi, extrude_axis=AXES.index(params["field_axis"]))
+    except ValueError as exc:
+        raise NodeInputError(f"{port} field: {exc}", where=port) from None
 
 
 @register
@@ -21,13 +48,21 @@ class ParticlesNode(NodeType):
     """A suspension of non-touching particles, one per cell of a cubic grid (paper 004, 3.1):
     random position, size and orientation per cell from a hash of the cell index and the seed
     (the same cloud in the viewport, the tracer and every export), a cell kept with
-    probability `density` (Russian roulette; optionally ramped along an axis), surfaces
-    offset and the domain warped.  Union two clouds for a multi-phase medium."""
+    probability `density` (Russian roulette; optionally ramped along an axis, times the
+    optional `density` Field read at the cell centre), kept only where a correlation rule
+    allows (clusters: positive correlation by rejection, paper 004 supp. 10.2), surfaces
+    offset (plus the optional `offset` Field) and the domain warped.  A 2-D Field (over
+    (u, v) = its x, y) is extruded along `field_axis`: u, v become x, y for z, x, z for y and
+    y, z for x.  Union two clouds for a multi-phase medium."""
 
     type_name = "Particles"
     title = "Particles"
     code = "prt"
     family = "implicit"
+    inputs = (Port("density", "Field", required=False,
+                   doc="scalar field in [0, 1] multiplying the keep probability (read at cell centres)"),
+              Port("offset", "Field", required=False,
+                   doc="scalar field (mm) added to the offset at each point; offset + its max < half a cell"))
     outputs = (Port("sdf", "SDF"),)
     params = (
         Param("cell", "float", 1.0, 1e-3, 1e4, unit="mm", doc="grid cell width: one particle per cell at most"),
@@ -49,12 +84,27 @@ class ParticlesNode(NodeType):
         Param("grade_to", "float", 10.0, -1e4, 1e4, unit="mm", doc="coordinate where the ramp ends"),
         Param("offset", "float", 0.0, -1e4, 1e4, unit="mm",
               doc="moves every particle surface outwards (< half a cell)"),
+        Param("field_axis", "enum", "z", choices=AXES,
+              doc="a 2-D density / offset Field is extruded along this axis (its x, y become the "
+                  "other two axes in order)"),
+        Param("correlation", "enum", "none", choices=CORRELATIONS,
+              doc="none; clusters: only cells with every index mod cluster_period below cluster_size "
+                  "(cubic clusters); rule: only cells correlation_rule keeps"),
+        Param("cluster_period", "int", 4, 2, 46340, unit="cells", doc="period of the clusters"),
+        Param("cluster_size", "int", 2, 1, 46339, unit="cells", doc="cluster edge in cells (< cluster_period)"),
+        Param("correlation_rule", "json", None, check=rule_json,
+              doc="a congruence rule as JSON, the Agglomerate node's format: {\"polynomials\": "
+                  "[[[a, [ex, ey, ez]], ...], ...], \"moduli\": [m or null, ...], \"classes\": "
+                  "[[[value, sign], ...], ...], \"inner\": \"or\", \"outer\": \"or\"}"),
         Param("warp_amplitude", "float", 0.0, 0.0, 1e4, unit="mm", doc="domain warp p + a sin(f p.yzx)"),
         Param("warp_frequency", "float", 0.0, 0.0, 1e4, unit="rad/mm", doc="frequency of the domain warp"),
         Param("seed", "int", 1, 0, 2 ** 31 - 1, doc="the cloud's seed: same seed, same cloud"),
     )
 
     def evaluate(self, inputs, params, ctx):
+        density_field = _grid_field(inputs, "density", params)
+        offset_field = _grid_field(inputs, "offset", params)
+
         def make():
             size = SizeDistribution(params["distribution"], params["size_a"],
                                     params["size_b"] if params["distribution"] != "fixed" else 0.0)
@@ -64,9 +114,12 @@ class ParticlesNode(NodeType):
                 density_end=params["density_end"] if params["graded"] else None,
                 density_axis=AXES.index(params["grade_axis"]),
                 density_span=(params["grade_from"], params["grade_to"]),
-                offset=params["offset"], warp_amplitude=params["warp_amplitude"],
+                density_field=density_field, rule=_correlation_rule(params),
+                offset=params["offset"], offset_field=offset_field, warp_amplitude=params["warp_amplitude"],
                 warp_frequency=params["warp_frequency"], seed=params["seed"])
-        return {"sdf": built(make, params, {"size distribution parameter": "size_a", "cell width": "cell",
+        return {"sdf": built(make, params, {"density_field": "density", "offset_field": "offset",
+                                            "cluster period": "cluster_period", "cluster size": "cluster_size",
+                                            "size distribution parameter": "size_a", "cell width": "cell",
                                             "density_span": "grade_to", "density_end": "density_end"})}
 
 

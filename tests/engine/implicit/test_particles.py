@@ -6,10 +6,18 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from engine.implicit import cell_hash
+from engine.implicit.congruence import CombinedRule, fibres, laminates
+from engine.implicit.field_sampling import GridField
+from engine.implicit.particle_fields import clusters
 from engine.implicit.particles import SizeDistribution, Suspension, shoemake_rotation
 from engine.implicit.shapes import SHAPES
 
 W = 1.0
+_RNG = np.random.default_rng(123)
+# a density field varying over the test box (and clamped beyond it), an offset field in mm
+DENSITY = GridField(_RNG.uniform(0.0, 1.0, (4, 5, 6)), (-2.0, -2.0, -2.0), (3.0, 3.0, 3.0))
+OFFSET = GridField(_RNG.uniform(-0.08, 0.12, (3, 4, 5)), (-2.5, -1.0, -2.0), (3.0, 3.5, 2.5))
 
 
 def _points(n, lo=-2.0, hi=3.0, seed=0):
@@ -31,6 +39,12 @@ def _brute_force(sus, x, exact_sphere=False):
     return best
 
 
+def _total_offset(sus, x):
+    """offset + o(x) (mm) at points x of the particle frame, o sampled by the field itself
+    (tested on its own in test_field_sampling)."""
+    return sus.offset + (0.0 if sus.offset_field is None else sus.offset_field.sample(x))
+
+
 CLOUDS = {
     "spheres_normal": dict(size=SizeDistribution("normal", 0.3, 0.08), density=0.7),
     "boxes_oriented": dict(shape="box", proportions=(1.0, 0.6, 0.4), orient=True,
@@ -39,6 +53,13 @@ CLOUDS = {
                                   size=SizeDistribution("lognormal", math.log(0.3), 0.25)),
     "capsules_offset": dict(shape="capsule", orient=True, offset=0.05, jitter=0.6,
                             size=SizeDistribution("fixed", 0.2)),
+    "density_field": dict(size=SizeDistribution("uniform", 0.2, 0.45), density_field=DENSITY),
+    "offset_field": dict(shape="ellipsoid", orient=True, offset=0.02, offset_field=OFFSET,
+                         size=SizeDistribution("normal", 0.25, 0.05)),
+    "clusters_rule": dict(size=SizeDistribution("fixed", 0.4), jitter=0.3, rule=clusters(3, 2)),
+    "all_three": dict(shape="round_box", orient=True, density=0.9, density_field=DENSITY,
+                      offset_field=OFFSET, rule=CombinedRule((fibres(3, 2), laminates(4, 0, 3)), "or"),
+                      size=SizeDistribution("uniform", 0.15, 0.35)),
 }
 
 
@@ -47,13 +68,14 @@ def test_lower_bound_of_the_distance_to_the_particles(name):
     sus = Suspension(cell=W, seed=4, **CLOUDS[name])
     x = _points(3000)
     f = sus.field(x)
-    ref = _brute_force(sus, x, exact_sphere=(sus.shape == "sphere")) - sus.offset
+    total = np.broadcast_to(_total_offset(sus, x), len(x))
+    ref = _brute_force(sus, x, exact_sphere=(sus.shape == "sphere")) - total
     # lower bound everywhere; exact within w / 2 of the particles (and inside them)
     assert np.all(f <= ref + 1e-12)
-    near = ref < 0.5 * W - sus.offset
+    near = ref < 0.5 * W - total
     assert near.mean() > 0.3
     np.testing.assert_allclose(f[near], ref[near], rtol=0, atol=1e-12)
-    assert np.all(f[~near] >= 0.5 * W - sus.offset - 1e-12)
+    assert np.all(f[~near] >= 0.5 * W - total[~near] - 1e-12)
 
 
 def test_empty_cells_give_the_distance_to_the_dual_block():
@@ -84,6 +106,10 @@ def test_warp_moves_the_particle_frame():
     dict(shape="torus", orient=True, warp_amplitude=0.2, warp_frequency=2.5,
          size=SizeDistribution("fixed", 0.4)),
     dict(shape="hex_prism", orient=True, offset=-0.1, density=0.5, density_end=1.0, density_span=(-1, 2)),
+    dict(offset_field=OFFSET, density_field=DENSITY, size=SizeDistribution("uniform", 0.2, 0.4)),
+    dict(shape="box", orient=True, offset_field=GridField(
+        np.random.default_rng(8).uniform(-0.3, 0.3, (6, 6, 6)), (-2, -2, -2), (3, 3, 3)),
+         warp_amplitude=0.1, warp_frequency=2.0, rule=clusters(2, 1)),
 ])
 def test_gradient_within_the_carried_bound(kw):
     sus = Suspension(cell=W, seed=9, **kw)
@@ -138,6 +164,90 @@ def test_density_ramp_along_an_axis():
         assert abs(kept - p * n) <= 4 * math.sqrt(n * p * (1 - p)), (y, kept)
 
 
+def _box_cells(c0, c1):
+    return [(i, j, k) for i in range(c0[0], c1[0] + 1) for j in range(c0[1], c1[1] + 1)
+            for k in range(c0[2], c1[2] + 1)]
+
+
+def _roulette_uniform(seed, cell):
+    """u_0 of one cell, straight from the hash."""
+    st = cell_hash.cell_stream(np.array([cell[0]]), np.array([cell[1]]), np.array([cell[2]]),
+                               cell_hash.seed_word(seed))
+    return float(cell_hash.cell_uniform(st, 0)[0])
+
+
+def test_density_field_keeps_the_cells_a_per_cell_loop_keeps():
+    sus = Suspension(cell=0.5, seed=13, density=0.9, density_end=0.4, density_axis=0, density_span=(-1.0, 2.0),
+                     density_field=DENSITY, size=SizeDistribution("fixed", 0.2))
+    c0, c1 = (-6, -5, -6), (5, 6, 5)
+    want = set()
+    for c in _box_cells(c0, c1):
+        centre = (np.array(c) + 0.5) * 0.5
+        t = min(max((centre[0] + 1.0) / 3.0, 0.0), 1.0)
+        p = (0.9 * (1 - t) + 0.4 * t) * DENSITY.sample(centre[None])[0]
+        if _roulette_uniform(13, c) < p:
+            want.add(c)
+    got = sus.particles_in_box(np.array(c0) * 0.5, np.array(c1) * 0.5 + 0.25)
+    assert set(map(tuple, got.cells.tolist())) == want
+    assert 0.2 * 12 ** 3 < len(want) < 0.8 * 12 ** 3
+
+
+def test_density_field_sets_the_kept_fraction():
+    # 0.25 where x < 10 (clamped below the first sample centre), 1 beyond x = 30, linear between
+    field = GridField(np.array([[[0.25, 1.0]]]), (0.0, 0.0, 0.0), (40.0, 30.0, 30.0))
+    sus = Suspension(cell=1.0, seed=4, density_field=field, size=SizeDistribution("fixed", 0.3))
+    parts = sus.particles_in_box((0, 0, 0), (39.5, 29.5, 29.5))
+    n = 30 * 30
+    for xs, p in [(range(0, 10), 0.25), (range(30, 40), 1.0), (range(19, 20), 0.25 + 0.75 * 9.5 / 20)]:
+        kept = np.sum(np.isin(parts.cells[:, 0], list(xs)))
+        m = n * len(xs)
+        assert abs(kept - p * m) <= 4 * math.sqrt(m * p * (1 - p)) + 1e-9, (xs, kept)
+
+
+def test_offset_field_ramp_is_added_to_the_offset():
+    # samples of o = 0.02 + 0.05 x at the centres along x: trilinear reproduces it between them
+    xs = -2.0 + (np.arange(8) + 0.5) * 0.75
+    field = GridField(np.broadcast_to(0.02 + 0.05 * xs, (2, 3, 8)), (-2.0, -3.0, -3.0), (4.0, 3.0, 3.0))
+    sus = Suspension(cell=W, seed=6, offset=0.1, offset_field=field, size=SizeDistribution("uniform", 0.2, 0.35))
+    x = _points(4000, lo=xs[0], hi=xs[-1], seed=3)
+    total = 0.1 + 0.02 + 0.05 * x[:, 0]
+    ref = _brute_force(sus, x, exact_sphere=True) - total
+    f = sus.field(x)
+    near = ref < 0.5 * W - total
+    assert near.mean() > 0.5 and np.all(f <= ref + 1e-12)
+    np.testing.assert_allclose(f[near], ref[near], atol=1e-12)
+    assert sus.lipschitz == pytest.approx(1.0 + 0.05)
+
+
+@pytest.mark.parametrize("rule, by_hand", [
+    (clusters(3, 2), lambda c: all(v % 3 < 2 for v in c)),
+    (clusters(5, 1), lambda c: all(v % 5 == 0 for v in c)),
+    (laminates(4, 1, 2), lambda c: c[1] % 4 < 2),
+    (CombinedRule((fibres(3, 2), laminates(4, 0)), "or"), lambda c: (c[0] % 3 == 0 and c[1] % 3 == 0) or c[0] % 4 == 0),
+])
+def test_rule_keeps_the_cells_it_keeps_by_hand(rule, by_hand):
+    c0, c1 = (-7, -6, -5), (6, 7, 5)
+    box = (np.array(c0) + 0.1, np.array(c1) + 0.9)
+    every = Suspension(cell=1.0, seed=2, rule=rule, size=SizeDistribution("fixed", 0.3))
+    got = set(map(tuple, every.particles_in_box(*box).cells.tolist()))
+    assert got == {c for c in _box_cells(c0, c1) if by_hand(c)}
+    half = Suspension(cell=1.0, seed=2, rule=rule, density=0.6, size=SizeDistribution("fixed", 0.3))
+    got = set(map(tuple, half.particles_in_box(*box).cells.tolist()))
+    assert got == {c for c in _box_cells(c0, c1) if by_hand(c) and _roulette_uniform(2, c) < 0.6}
+
+
+def test_clusters_correlate_positively():
+    # among kept cells, a face neighbour is kept far more often than the kept fraction
+    sus = Suspension(cell=1.0, seed=1, density=0.5, rule=clusters(4, 2), size=SizeDistribution("fixed", 0.3))
+    cells = sus.particles_in_box((0, 0, 0), (39.5, 39.5, 39.5)).cells
+    kept = np.zeros((40, 40, 40), dtype=bool)
+    kept[tuple(cells.T)] = True
+    fraction = kept.mean()
+    pairs = kept[:-1] & kept[1:]
+    assert abs(fraction - 0.5 / 8) < 0.01
+    assert pairs.sum() / kept[:-1].sum() > 3 * fraction
+
+
 def test_size_distributions_match_their_parameters():
     box = ((0, 0, 0), (24.5, 24.5, 24.5))
     normal = Suspension(cell=1.0, size=SizeDistribution("normal", 0.2, 0.04), seed=3).particles_in_box(*box)
@@ -180,6 +290,13 @@ GLSL_CASES = [
     dict(shape="round_box", orient=True, size=SizeDistribution("normal", 0.3, 0.05)),
     dict(shape="torus", orient=True, warp_amplitude=0.2, warp_frequency=2.0,
          size=SizeDistribution("fixed", 0.4)),
+    dict(density_field=DENSITY, size=SizeDistribution("uniform", 0.2, 0.45)),
+    dict(density=0.7, density_end=0.2, density_span=(-3.0, 3.0), density_field=DENSITY),
+    dict(offset=0.05, offset_field=OFFSET, shape="ellipsoid", orient=True),
+    dict(rule=clusters(3, 2), size=SizeDistribution("fixed", 0.45)),
+    dict(rule=CombinedRule((fibres(3, 2), laminates(4, 0, 3)), "or"), density=0.8),
+    dict(shape="round_box", orient=True, density_field=DENSITY, offset_field=OFFSET, rule=clusters(2, 1),
+         warp_amplitude=0.1, warp_frequency=2.0),
 ] + [dict(shape=s, orient=True,
           size=SizeDistribution("uniform", 0.1, 0.48 / SHAPES[s].bound(*SHAPES[s].default)))
      for s in sorted(SHAPES)]
@@ -234,10 +351,29 @@ def test_fills_space_and_evaluates_a_grid():
     (dict(seed=1.5), "seed must be an int"),
     (dict(size=0.3), "SizeDistribution"),
     (dict(orient="yes"), "orient"),
+    (dict(density_field=GridField(np.array([[[0.5, 1.2]]]), (0, 0, 0), (1, 1, 1))),
+     r"density_field values must lie in \[0, 1\].*to 1.2"),
+    (dict(density_field=GridField(np.array([[[-0.1, 1.0]]]), (0, 0, 0), (1, 1, 1))), "density_field values"),
+    (dict(density_field=0.5), "density_field must be a GridField"),
+    (dict(offset=0.3, offset_field=GridField(np.array([[[0.0, 0.2]]]), (0, 0, 0), (1, 1, 1))),
+     r"offset \+ max\(offset_field\) = 0.3 \+ 0.2 mm must be < w / 2 = 0.5"),
+    (dict(offset_field=np.zeros((2, 2, 2))), "offset_field must be a GridField"),
+    (dict(rule="clusters"), "rule must be a CongruenceRule"),
 ])
 def test_bad_input_refused(kw, match):
     with pytest.raises(ValueError, match=match):
         Suspension(**kw)
+
+
+@pytest.mark.parametrize("args, match", [
+    ((1, 1), r"cluster period must be an int in \[2"),
+    ((4, 4), r"cluster size must be an int in \[1, 3\]"),
+    ((4, 0), "cluster size"),
+    ((4.0, 2), "cluster period"),
+])
+def test_bad_clusters_refused(args, match):
+    with pytest.raises(ValueError, match=match):
+        clusters(*args)
 
 
 @pytest.mark.parametrize("args, match", [
