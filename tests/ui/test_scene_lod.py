@@ -138,18 +138,23 @@ def test_decimated_levels_keep_the_shape():
         np.testing.assert_allclose(np.linalg.norm(cell.normals, axis=1), 1.0, atol=1e-5)
 
 
-def test_tiles_in_view_follow_the_frustum():
-    from ui.scene_prep import prepare_cell
+def _unit_box_tiles(plotter, offsets):
+    """A 1 mm box cell drawn at `offsets` in `plotter`'s renderer."""
     from ui.solid_actors import SolidActors
+
+    box = pv.Box(bounds=(0, 1, 0, 1, 0, 1)).triangulate()
+    view = SolidActors(plotter.renderer, pv.Property(), np.ones(3))
+    view.set_levels([prepare_cell(np.asarray(box.points), np.asarray(box.regular_faces))], complete=True)
+    view.set_offsets(offsets)
+    return view
+
+
+def test_tiles_in_view_follow_the_frustum():
     from ui.view_content import tile_offsets
 
     plotter = pv.Plotter(off_screen=True, window_size=(400, 400))
     try:
-        box = pv.Box(bounds=(0, 1, 0, 1, 0, 1)).triangulate()
-        cell = prepare_cell(np.asarray(box.points), np.asarray(box.regular_faces))
-        view = SolidActors(plotter.renderer, pv.Property(), np.ones(3))
-        view.set_levels([cell], complete=True)
-        view.set_offsets(tile_offsets(3, 1.0))
+        view = _unit_box_tiles(plotter, tile_offsets(3, 1.0))
         cam = plotter.camera
         cam.focal_point, cam.position, cam.up = (0.5, 0.5, 0.5), (0.5, 0.5, 20.0), (0, 1, 0)
         plotter.render()
@@ -168,18 +173,12 @@ def test_tiles_in_view_follow_the_frustum():
 
 
 def test_tiles_are_drawn_front_to_back():
-    from ui.scene_prep import prepare_cell
-    from ui.solid_actors import SolidActors
     from ui.view_content import tile_offsets
 
     plotter = pv.Plotter(off_screen=True, window_size=(300, 300))
     try:
-        box = pv.Box(bounds=(0, 1, 0, 1, 0, 1)).triangulate()
-        cell = prepare_cell(np.asarray(box.points), np.asarray(box.regular_faces))
-        view = SolidActors(plotter.renderer, pv.Property(), np.ones(3))
-        view.set_levels([cell], complete=True)
         offsets = tile_offsets(3, 1.0)
-        view.set_offsets(offsets)
+        view = _unit_box_tiles(plotter, offsets)
         cam = plotter.camera
         for eye in ((0.5, 0.5, 30.0), (0.5, 0.5, -30.0), (25.0, -20.0, 9.0)):
             cam.focal_point, cam.position = (0.5, 0.5, 0.5), eye
