@@ -13,7 +13,10 @@ latest evaluation (slot :meth:`ImplicitPanel.set_report`):
   edit re-evaluates and the view follows;
 * the solid volume fraction of the view box and the particle size histogram of a suspension;
 * "Fit to an exemplar" (`ui.implicit_fit.FitBox`): the node's parameters fitted to a grid, or
-  to an image taken at this view, applied as one undo step when asked.
+  to an image taken at this view, applied as one undo step when asked;
+* for a Scalar Field node (a density / offset field, no SDF) instead of the view: its paint
+  canvas (`ui.implicit_paint.FieldPaintBox`): a slice of the field, and each brush drag one
+  ``SetParam(node, "strokes", old + [stroke])`` on the undo stack.
 
 Every trace and measurement runs in a `TaskRunner` (a burst of view changes traces only the
 last); the GUI thread only draws.
@@ -30,6 +33,7 @@ from engine.nodes.sdf_preview import SDFPreview, fallback_box_for, orbit_directi
 
 from .colours import STATUS_COLOURS
 from .implicit_fit import FitBox
+from .implicit_paint import PAINTABLE, FieldPaintBox
 from .implicit_plots import SizeHistogram
 from .implicit_view import TraceView
 from .param_form import ParamForm
@@ -116,13 +120,16 @@ class ImplicitPanel(QtWidgets.QWidget):
         self.title = QtWidgets.QLabel("")
         self.title.setWordWrap(True)
         outer.addWidget(self.title)
-        self.view = TraceView(self)
-        self.view.view_changed.connect(lambda moving: self.request_trace(moving=moving))
-        outer.addWidget(self.view, 1)
         self.readout = QtWidgets.QLabel("")
         self.readout.setWordWrap(True)
         self.readout.setTextInteractionFlags(QtCore.Qt.TextInteractionFlag.TextSelectableByMouse)
-        outer.addWidget(self.readout)
+        self.sdf_box = QtWidgets.QWidget(self)      # what an SDF node shows; hidden for a field
+        sdf = QtWidgets.QVBoxLayout(self.sdf_box)
+        sdf.setContentsMargins(0, 0, 0, 0)
+        self.view = TraceView(self)
+        self.view.view_changed.connect(lambda moving: self.request_trace(moving=moving))
+        sdf.addWidget(self.view, 1)
+        sdf.addWidget(self.readout)
 
         controls = QtWidgets.QFormLayout()
         self.step_box = QtWidgets.QComboBox()
@@ -141,7 +148,7 @@ class ImplicitPanel(QtWidgets.QWidget):
         controls.addRow("path frames", self.paths_box)
         self.depth_box = ToolNumber(preview_param("max_depth"))
         controls.addRow("max depth", self.depth_box)
-        outer.addLayout(controls)
+        sdf.addLayout(controls)
         row = QtWidgets.QHBoxLayout()
         self.path_button = QtWidgets.QPushButton("Path trace")
         self.path_button.setToolTip("accumulate path-traced frames of this view (Monte Carlo)")
@@ -151,12 +158,17 @@ class ImplicitPanel(QtWidgets.QWidget):
         self.cancel_button.clicked.connect(self.traces.cancel)
         row.addWidget(self.path_button)
         row.addWidget(self.cancel_button)
-        outer.addLayout(row)
+        sdf.addLayout(row)
 
         self.fraction_label = QtWidgets.QLabel("volume fraction: —")
-        outer.addWidget(self.fraction_label)
+        sdf.addWidget(self.fraction_label)
         self.histogram = SizeHistogram(self)
-        outer.addWidget(self.histogram)
+        sdf.addWidget(self.histogram)
+        outer.addWidget(self.sdf_box, 1)
+        self.paint_box = FieldPaintBox(self.doc, self.undo, self)
+        self.paint_box.message.connect(self.message.emit)
+        self.paint_box.setVisible(False)
+        outer.addWidget(self.paint_box, 1)
         self.params_box = QtWidgets.QGroupBox("Parameters")
         self.form = QtWidgets.QFormLayout(self.params_box)
         self.form.setFieldGrowthPolicy(QtWidgets.QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
@@ -171,7 +183,7 @@ class ImplicitPanel(QtWidgets.QWidget):
     # -- which node -----------------------------------------------------------------------------
     def _accept(self, node_id: str) -> bool:
         node = self.doc.nodes.get(node_id)
-        return node is not None and node.type_name in sdf_node_types()
+        return node is not None and (node.type_name in sdf_node_types() or node.type_name in PAINTABLE)
 
     @QtCore.Slot(object)
     def set_selected(self, node_id) -> None:
@@ -198,14 +210,23 @@ class ImplicitPanel(QtWidgets.QWidget):
         if self.param_form.node_id != nid or (nid is not None and not self.param_form.editors):
             cls = all_node_types()[self.doc.nodes[nid].type_name] if nid else None
             self.param_form.show_node(nid, cls.params if cls else ())
+        painted = nid is not None and self.doc.nodes[nid].type_name in PAINTABLE
+        self.sdf_box.setVisible(not painted)
+        self.fit_box.setVisible(not painted)
+        self.paint_box.setVisible(painted)
         if nid is None:
             self.fit_box.set_node(None, {})
+            self.paint_box.set_field(None, None, {})
             self.title.setText("No node with an SDF output: add Particles, Periodic Function, Agglomerate "
-                               "or Pile (Tab in the node graph).")
+                               "or Pile (Tab in the node graph), or a Scalar Field to paint.")
             self._set_sdf(None, "select a node with an SDF output")
             return
         node = self.doc.nodes[nid]
         self.title.setText(f"<b>{node.type_name}</b> · {nid}")
+        if painted:
+            self._show_field(nid, node)
+            return
+        self.paint_box.set_field(None, None, {})
         self.fit_box.set_node(nid, self.node_inputs())
         result = self.results.get(nid)
         value = (self.outputs.get(nid) or {}).get("sdf")
@@ -217,6 +238,17 @@ class ImplicitPanel(QtWidgets.QWidget):
             self._set_sdf(value, "")
         else:
             self._set_sdf(None, "not evaluated yet")
+
+    def _show_field(self, nid: str, node) -> None:
+        """A Scalar Field node: its paint canvas over the latest evaluated field."""
+        self.fit_box.set_node(None, {})
+        self._set_sdf(None, "")
+        result = self.results.get(nid)
+        field = (self.outputs.get(nid) or {}).get("field")
+        failed = result is not None and getattr(result, "status", "") == "failed"
+        self.paint_box.set_field(nid, None if failed else field, node.params)
+        if failed:
+            self.paint_box.status.setText(f"<span style='color:{STATUS_COLOURS['failed']}'>{result.error}</span>")
 
     def _set_sdf(self, sdf, note: str) -> None:
         if sdf is self.sdf and sdf is not None:

@@ -176,6 +176,7 @@ DOCK_OF_TYPE = {
     "PhasorPreview": "Phasor Infill", "MeshImport": "Phasor Infill",
     "TopOpt": "Reaction Diffusion", "RDFields": "Reaction Diffusion", "RDGrow": "Reaction Diffusion",
     "RDCompile": "Reaction Diffusion",
+    "ScalarField": "Implicit Media",
 }
 """The dock that shows a node type's 2D results (slices, tilings, fields)."""
 

@@ -6,22 +6,13 @@ shape and what it paints.  :func:`apply_stroke` is a pure function that
 returns new fields and the bounding box of the cells it touched, so the
 document can keep one undo item per stroke (the old values in that box).
 
-In-plane coordinates
---------------------
+In-plane coordinates and brush weight
+-------------------------------------
 A stroke on the plane normal to ``axis`` at ``position`` mm has points
-``(u, v)`` in mm on the two other axes in x, y, z order::
-
-    axis "z": (u, v) = (x, y)     axis "y": (u, v) = (x, z)     axis "x": (u, v) = (y, z)
-
-Brush weight
-------------
-For a cell centre with in-plane distance ``d`` to the polyline and offset
-``n`` from the plane, the brush sees the distance
-``s = sqrt(d**2 + (n * radius / depth)**2) / radius`` (with ``depth ==
-radius`` this is the plain 3-D distance to the polyline over the radius), and
-weights the cell by ``w = strength * falloff(s)``, zero for ``s >= 1``::
-
-    constant: 1          linear: 1 - s          smooth: 1 - 3 s**2 + 2 s**3
+``(u, v)`` in mm on the two other axes; each cell centre is weighted
+``w = strength * falloff(s)`` by its distance ``s`` to the polyline over the
+radius (out of the plane scaled by ``radius / depth``).  Both rules are
+`engine.geometry.plane_brush`'s, the brush every painted field shares.
 
 Painting
 --------
@@ -43,15 +34,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from engine.geometry.plane_brush import FALLOFFS, PLANE_AXES, drag_segments, plane_brush
 from engine.phasor.fields import MAX_SPREAD, PhasorFields
 
 __all__ = ["Stroke", "apply_stroke", "apply_strokes", "stroke_weights", "check_number", "FALLOFFS",
            "FIELDS", "LIMITS", "PLANE_AXES"]
 
 FIELDS = ("D", "F", "Gamma")
-FALLOFFS = ("smooth", "linear", "constant")
-# plane axis -> (u, v, normal) as indices into (x, y, z)
-PLANE_AXES = {"x": (1, 2, 0), "y": (0, 2, 1), "z": (0, 1, 2)}
 _CANCELLED = 1e-9  # a blended direction shorter than this keeps the old one
 
 # What a stroke's numbers may be: name -> (low, high, low excluded, what is expected).
@@ -154,7 +143,7 @@ class Stroke:
                                      f"direction, got {self.heading!r}")
                 h.setflags(write=False)
                 set_("heading", h)
-            elif len(_drag_segments(self.points)[0]) == 0:
+            elif len(drag_segments(self.points)[0]) == 0:
                 raise ValueError("Stroke.heading: the stroke never moves, so it has no drag "
                                  "direction; give a heading")
             return
@@ -205,90 +194,21 @@ class Stroke:
         return cls.from_dict(data)
 
 
-# --- geometry ----------------------------------------------------------------------
-
-def _drag_segments(points):
-    """Segment starts (m, 2) and ends (m, 2) with repeated points dropped."""
-    keep = np.ones(len(points), dtype=bool)
-    keep[1:] = np.any(points[1:] != points[:-1], axis=1)
-    p = points[keep]
-    return p[:-1], p[1:]
-
-
-def _falloff(s, kind):
-    inside = s < 1.0
-    if kind == "constant":
-        return inside.astype(np.float64)
-    if kind == "linear":
-        return np.where(inside, 1.0 - s, 0.0)
-    return np.where(inside, 1.0 - s * s * (3.0 - 2.0 * s), 0.0)
-
-
-def _index_range(lo, step, n, a, b):
-    """Cells whose centres may lie in [a, b] along one axis, as (start, stop)."""
-    start = max(int(math.floor((a - lo) / step - 0.5)), 0)
-    stop = min(int(math.ceil((b - lo) / step - 0.5)) + 1, n)
-    return start, max(start, stop)
-
-
-def _block(fields, stroke):
-    """Index ranges ((k0, k1), (j0, j1), (i0, i1)) that can hold brushed cells."""
-    u, v, n = PLANE_AXES[stroke.axis]
-    lo_xyz = np.empty(3)
-    hi_xyz = np.empty(3)
-    lo_xyz[[u, v]] = stroke.points.min(axis=0) - stroke.radius
-    hi_xyz[[u, v]] = stroke.points.max(axis=0) + stroke.radius
-    lo_xyz[n], hi_xyz[n] = stroke.position - stroke.reach, stroke.position + stroke.reach
-    step, counts = fields.spacing, fields.shape[::-1]
-    ranges = [_index_range(fields.lo[a], step[a], counts[a], lo_xyz[a], hi_xyz[a]) for a in range(3)]
-    return ranges[::-1]
-
-
-def _block_coords(fields, ranges):
-    """Cell-centre x, y, z over a block, each shaped to broadcast as [z, y, x]."""
-    out = []
-    for a, (start, stop) in zip(range(3), ranges[::-1]):
-        c = fields.lo[a] + (np.arange(start, stop) + 0.5) * fields.spacing[a]
-        shape = [1, 1, 1]
-        shape[2 - a] = len(c)
-        out.append(c.reshape(shape))
-    return out
-
-
-def _polyline_distance(pu, pv, stroke):
-    """Squared in-plane distance to the polyline and the nearest segment's index."""
-    starts, ends = _drag_segments(stroke.points)
-    if len(starts) == 0:
-        a = stroke.points[0]
-        return (pu - a[0]) ** 2 + (pv - a[1]) ** 2, None
-    best = np.full(np.broadcast_shapes(pu.shape, pv.shape), np.inf)
-    which = np.zeros(best.shape, dtype=np.intp)
-    for m, (a, b) in enumerate(zip(starts, ends)):
-        e = b - a
-        t = np.clip(((pu - a[0]) * e[0] + (pv - a[1]) * e[1]) / (e @ e), 0.0, 1.0)
-        d2 = (pu - a[0] - t * e[0]) ** 2 + (pv - a[1] - t * e[1]) ** 2
-        closer = d2 < best
-        best = np.where(closer, d2, best)
-        which = np.where(closer, m, which)
-    return best, which
-
+# --- the brush (engine.geometry.plane_brush) ---------------------------------------
 
 def _brush(fields, stroke):
     """Weights (block,) and, for D, the painted directions (block, 3) over the block."""
-    ranges = _block(fields, stroke)
+    ranges, w, which = plane_brush(fields.lo, fields.spacing, fields.shape, axis=stroke.axis,
+                                   position=stroke.position, points=stroke.points, radius=stroke.radius,
+                                   reach=stroke.reach, strength=stroke.strength, kind=stroke.falloff)
     u, v, n = PLANE_AXES[stroke.axis]
-    coords = _block_coords(fields, ranges)
-    d2, which = _polyline_distance(coords[u], coords[v], stroke)
-    dn = (coords[n] - stroke.position) * (stroke.radius / stroke.reach)
-    s = np.sqrt(d2 + dn * dn) / stroke.radius
-    w = stroke.strength * _falloff(s, stroke.falloff)
     target = None
     if stroke.field == "D":
         if stroke.heading is not None:
             tangents = (stroke.heading / np.linalg.norm(stroke.heading))[None]
-            which = np.zeros(d2.shape, dtype=np.intp)
+            which = np.zeros(w.shape, dtype=np.intp)
         else:
-            starts, ends = _drag_segments(stroke.points)
+            starts, ends = drag_segments(stroke.points)
             tangents = (ends - starts) / np.linalg.norm(ends - starts, axis=1, keepdims=True)
         t3 = np.zeros((len(tangents), 3))
         t3[:, u] = math.cos(stroke.tilt) * tangents[:, 0]
