@@ -97,6 +97,10 @@ class Param:
         for the values of ``samples``.
     check : for ``json``: callable(data) -> canonical data, raising ValueError
         (whose message says what was expected) when the data is refused.
+    active : callable(params) -> bool, whether the parameter takes effect given the
+        node's other parameters (e.g. a ramp's end only when the ramp is on); None:
+        always.  What chooses parameters to vary (fits, explorations) skips the
+        inactive ones.
     """
 
     name: str
@@ -109,6 +113,11 @@ class Param:
     doc: str = ""
     label: str = field(default="")
     check: Callable[[Any], Any] | None = field(default=None, compare=False, repr=False)
+    active: Callable[[dict], bool] | None = field(default=None, compare=False, repr=False)
+
+    def is_active(self, params: dict) -> bool:
+        """Whether this parameter takes effect under `params` (see `active`)."""
+        return self.active is None or bool(self.active(params))
 
     def __post_init__(self):
         if self.kind not in PARAM_KINDS:

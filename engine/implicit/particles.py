@@ -20,10 +20,13 @@ its index and the seed (`cell_hash`), the same numbers in numpy and GLSL:
 * u_6 .. u_8: an optional uniformly random rotation (Shoemake's quaternion).
 
 The particle is the unit shape (`shapes.SHAPES`, parameters `proportions`)
-scaled by s and rotated.  A point x (after the optional warp
-``x = p + a sin(f p.yzx)``) lies in one cell of the dual grid (offset by
-w / 2); its 2 x 2 x 2 block of nearest cells, from ``floor(x / w - 0.5)``,
-are the only ones whose particles can reach it (eq. 4).  The field is
+scaled by s and rotated.  A point x (after the optional turbulence warp
+``x = p + A T(p)`` of `turbulence.Turbulence`, supplementary 10.1: octaves of
+sines of the mixed, cyclically shifted coordinates; one octave with a scalar
+amplitude a and no mixing is ``x = p + a sin(f p.yzx)``) lies in one cell of
+the dual grid (offset by w / 2); its 2 x 2 x 2 block of nearest cells, from
+``floor(x / w - 0.5)``, are the only ones whose particles can reach it
+(eq. 4).  The field is
 
     f(x) = min( min over the block's particles of d_i(x),  b(x) ) - offset - o(x),
 
@@ -43,10 +46,12 @@ A min of 1-Lipschitz functions, min(g, b) is 1-Lipschitz (L_s for a
 non-Euclidean shape); o, trilinear in its samples, has ``|grad o| <= L_o``
 (`field_sampling`: ``sqrt(Dx^2 + Dy^2 + Dz^2) <= sqrt(3) max_a Da``, Da the
 largest sample difference along axis a over the spacing), so f is
-``(L_s + L_o)``-Lipschitz in x; the warp multiplies the bound by
-``1 + a f``.  The total offset ``offset + o(x)`` must stay below w / 2
-everywhere (o never exceeds its largest sample) so that b - offset - o > 0:
-the guard never creates material away from the particles; then, where
+``(L_s + L_o)``-Lipschitz in x; the warp multiplies the bound by its own
+Lipschitz constant ``1 + ||A||_2 ||M||_2 f sum_o (g l)^o`` (proved in
+`turbulence`; ``1 + a f`` for the single-octave warp).  The total offset
+``offset + o(x)`` must stay below w / 2 everywhere (o never exceeds its
+largest sample) so that b - offset - o > 0: the guard never creates
+material away from the particles; then, where
 f <= 0, min(g, b) < w / 2 <= b, so f is the particles' own distance minus
 the offset and (exact shapes) the solid is ``{x : dist(x, particles) <=
 offset + o(x)}``.  There is no lower limit on ``offset + o``: where it is
@@ -67,7 +72,8 @@ from .congruence import CombinedRule, CongruenceRule
 from .field_sampling import GridField
 from .particle_fields import check_density_field, check_offset_field, check_rule
 from .shapes import check_shape_params, shape_glsl, shape_spec
-from .values import SDF, as_points, glsl_float
+from .turbulence import Turbulence
+from .values import SDF, glsl_float
 
 __all__ = ["SizeDistribution", "Suspension", "Particles", "shoemake_rotation", "MAX_BOX_CELLS"]
 
@@ -216,7 +222,15 @@ class Suspension(SDF):
     offset_field : GridField (or a Field-like, mm) or None: added to `offset` at x; the
         total ``offset + max(offset_field)`` must stay < w / 2 (no lower limit: where
         ``offset + o(x) <= -w / 2`` no particle remains).
-    warp_amplitude : float, mm (>= 0); warp_frequency : float, rad / mm (>= 0).
+    warp_amplitude : float, mm (>= 0); warp_frequency : float, rad / mm (>= 0): the warp
+        ``x = p + A T(p)`` (`turbulence.Turbulence`) with A = warp_amplitude * I.
+    warp_octaves : int in [1, 8]; warp_gain : float in (0, 1]; warp_lacunarity : float in
+        [1, 4]: the octaves of T, each `warp_gain` times the amplitude and `warp_lacunarity`
+        times the frequency of the one before (octave 0 has phase 0, the others phases fixed
+        by `seed`).
+    warp_matrix : None or a 3 x 3 matrix M (finite) mixing p before the octaves read it.
+    warp_amplitudes : None or a 3 x 3 matrix A (mm, finite) used instead of
+        ``warp_amplitude * I``.
     seed : int.
 
     Raises
@@ -242,6 +256,11 @@ class Suspension(SDF):
     offset_field: GridField | None = None
     warp_amplitude: float = 0.0
     warp_frequency: float = 0.0
+    warp_octaves: int = 1
+    warp_gain: float = 0.5
+    warp_lacunarity: float = 2.0
+    warp_matrix: tuple | None = None
+    warp_amplitudes: tuple | None = None
     seed: int = 0
 
     def __post_init__(self):
@@ -281,15 +300,31 @@ class Suspension(SDF):
         object.__setattr__(self, "offset_field", check_offset_field(self.offset_field, self.offset, w))
         check_rule(self.rule)
         word = cell_hash.seed_word(self.seed)
+        warp = self._turbulence_of()
         for k, v in (("cell", w), ("proportions", props), ("_bound", bound), ("_smax", smax),
-                     ("_word", word)):
+                     ("_word", word), ("_warp", warp), ("warp_octaves", warp.octaves),
+                     ("warp_gain", warp.gain), ("warp_lacunarity", warp.lacunarity),
+                     ("warp_matrix", warp.matrix),
+                     ("warp_amplitudes", None if self.warp_amplitudes is None else warp.amplitude)):
             object.__setattr__(self, k, v)
+
+    def _turbulence_of(self) -> Turbulence:
+        """The warp of the warp_* fields (checked, refusals naming those fields)."""
+        full = self.warp_amplitudes is not None
+        names = {"amplitude": "warp_amplitudes" if full else "warp_amplitude", "frequency": "warp_frequency",
+                 "octaves": "warp_octaves", "gain": "warp_gain", "lacunarity": "warp_lacunarity",
+                 "matrix": "warp_matrix"}
+        return Turbulence.named(
+            names, amplitude=self.warp_amplitudes if full else self.warp_amplitude,
+            frequency=self.warp_frequency, octaves=self.warp_octaves, gain=self.warp_gain,
+            lacunarity=self.warp_lacunarity, matrix=self.warp_matrix, seed=self.seed)
 
     @property
     def lipschitz(self):
-        """(L_s + L_o) (1 + a f): the shape's bound plus the offset field's, times the warp's."""
+        """(L_s + L_o) L_w: the shape's bound plus the offset field's, times the warp's
+        (`Turbulence.lipschitz`, 1 + a f for the single-octave warp)."""
         l_o = 0.0 if self.offset_field is None else self.offset_field.lipschitz
-        return (shape_spec(self.shape).lipschitz + l_o) * (1.0 + self.warp_amplitude * self.warp_frequency)
+        return (shape_spec(self.shape).lipschitz + l_o) * self._warp.lipschitz
 
     # -- the particles of given cells -------------------------------------------------
 
@@ -349,11 +384,8 @@ class Suspension(SDF):
     # -- evaluation -------------------------------------------------------------------
 
     def warp(self, points) -> np.ndarray:
-        """The particles' frame of world points: x = p + a sin(f p.yzx), (n, 3) mm."""
-        p = as_points(points)
-        if self.warp_amplitude == 0.0:
-            return p
-        return p + self.warp_amplitude * np.sin(self.warp_frequency * p[:, [1, 2, 0]])
+        """The particles' frame of world points: x = p + A T(p) (`Turbulence.warp`), (n, 3) mm."""
+        return self._warp.warp(points)
 
     def field(self, points):
         x = self.warp(points)
@@ -397,10 +429,7 @@ class Suspension(SDF):
         offset = glsl_float(self.offset)
         if self.offset_field is not None:
             offset = f"{offset} + {self.offset_field.glsl(module)}(x)"
-        x = "p"
-        if self.warp_amplitude != 0.0:
-            x = (f"p + {glsl_float(self.warp_amplitude)} * "
-                 f"sin({glsl_float(self.warp_frequency)} * p.yzx)")
+        x = "p" if self._warp.is_identity else f"{self._warp.glsl(module)}(p)"
         def u(r):
             return f"mf_cell_uniform(st, {r}u)"
         rotate = f"q = q * mf_shoemake({u(6)}, {u(7)}, {u(8)});" if self.orient else ""

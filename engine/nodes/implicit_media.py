@@ -19,6 +19,39 @@ from .implicit_common import AXES, built, make_rule, rule_json
 CORRELATIONS = ("none", "clusters", "rule")
 
 
+# when a parameter takes effect (`Param.active`): what a fit may vary
+def _graded(p):
+    return bool(p["graded"])
+
+
+def _sized(p):
+    return p["distribution"] != "fixed"
+
+
+def _warp_on(p):
+    return p["warp_amplitude"] > 0 and p["warp_frequency"] > 0
+
+
+def _octaves(p):
+    return _warp_on(p) and p["warp_octaves"] > 1
+
+
+def _by_level(p):
+    return p["level_by"] == "level"
+
+
+def _by_fraction(p):
+    return p["level_by"] == "volume fraction"
+
+
+def _graded_level(p):
+    return _graded(p) and _by_level(p)
+
+
+def _graded_fraction(p):
+    return _graded(p) and _by_fraction(p)
+
+
 def _correlation_rule(params):
     """The cell rule of the node's `correlation` choice (None: no rejection by rule)."""
     kind = params["correlation"]
@@ -43,6 +76,16 @@ def _grid_field(inputs, port, params):
         raise NodeInputError(f"{port} field: {exc}", where=port) from None
 
 
+def _warp_amplitudes(params):
+    """The warp's amplitude matrix diag(warp_amplitude x warp_anisotropy), or None (the scalar
+    warp_amplitude) when every factor is 1."""
+    factors = [float(v) for v in params["warp_anisotropy"]]
+    if factors == [1.0, 1.0, 1.0]:
+        return None
+    a = float(params["warp_amplitude"])
+    return tuple(tuple(a * factors[i] if i == j else 0.0 for j in range(3)) for i in range(3))
+
+
 @register
 class ParticlesNode(NodeType):
     """A suspension of non-touching particles, one per cell of a cubic grid (paper 004, 3.1):
@@ -51,7 +94,9 @@ class ParticlesNode(NodeType):
     probability `density` (Russian roulette; optionally ramped along an axis, times the
     optional `density` Field read at the cell centre), kept only where a correlation rule
     allows (clusters: positive correlation by rejection, paper 004 supp. 10.2), surfaces
-    offset (plus the optional `offset` Field) and the domain warped.  A 2-D Field (over
+    offset (plus the optional `offset` Field) and the domain warped by a turbulence of sine
+    octaves (supp. 10.1: regions of different particle shape and anisotropy, blending
+    smoothly; a multi-phase cloud).  A 2-D Field (over
     (u, v) = its x, y) is extruded along `field_axis`: u, v become x, y for z, x, z for y and
     y, z for x.  Union two clouds for a multi-phase medium."""
 
@@ -72,16 +117,16 @@ class ParticlesNode(NodeType):
                   "lognormal (mu a = log of the median in mm, sigma b)"),
         Param("size_a", "float", 0.2, -20.0, 1e4, unit="mm",
               doc="first size parameter (see distribution); the bounding radius must fit half a cell"),
-        Param("size_b", "float", 0.4, 0.0, 1e4, unit="mm", doc="second size parameter (see distribution)"),
+        Param("size_b", "float", 0.4, 0.0, 1e4, unit="mm", doc="second size parameter (see distribution)", active=_sized),
         Param("jitter", "float", 1.0, 0.0, 1.0,
               doc="0: every particle at its cell centre (a lattice); 1: anywhere it fits in its cell"),
         Param("orient", "bool", True, doc="random particle orientations"),
         Param("density", "float", 1.0, 0.0, 1.0, doc="probability that a cell holds a particle"),
         Param("graded", "bool", False, doc="ramp the density linearly along an axis"),
-        Param("density_end", "float", 0.0, 0.0, 1.0, doc="density at the end of the ramp"),
+        Param("density_end", "float", 0.0, 0.0, 1.0, doc="density at the end of the ramp", active=_graded),
         Param("grade_axis", "enum", "z", choices=AXES, doc="axis of the density ramp"),
-        Param("grade_from", "float", 0.0, -1e4, 1e4, unit="mm", doc="coordinate where the ramp starts"),
-        Param("grade_to", "float", 10.0, -1e4, 1e4, unit="mm", doc="coordinate where the ramp ends"),
+        Param("grade_from", "float", 0.0, -1e4, 1e4, unit="mm", doc="coordinate where the ramp starts", active=_graded),
+        Param("grade_to", "float", 10.0, -1e4, 1e4, unit="mm", doc="coordinate where the ramp ends", active=_graded),
         Param("offset", "float", 0.0, -1e4, 1e4, unit="mm",
               doc="moves every particle surface outwards (< half a cell)"),
         Param("field_axis", "enum", "z", choices=AXES,
@@ -96,12 +141,21 @@ class ParticlesNode(NodeType):
               doc="a congruence rule as JSON, the Agglomerate node's format: {\"polynomials\": "
                   "[[[a, [ex, ey, ez]], ...], ...], \"moduli\": [m or null, ...], \"classes\": "
                   "[[[value, sign], ...], ...], \"inner\": \"or\", \"outer\": \"or\"}"),
-        Param("warp_amplitude", "float", 0.0, 0.0, 1e4, unit="mm", doc="domain warp p + a sin(f p.yzx)"),
-        Param("warp_frequency", "float", 0.0, 0.0, 1e4, unit="rad/mm", doc="frequency of the domain warp"),
+        Param("warp_amplitude", "float", 0.0, 0.0, 1e4, unit="mm",
+              doc="turbulence warp p + A T(p), A = amplitude x diag(anisotropy); one octave: "
+                  "p + a sin(f p.yzx)", active=_warp_on),
+        Param("warp_frequency", "float", 0.0, 0.0, 1e4, unit="rad/mm", doc="frequency of the warp's first octave", active=_warp_on),
+        Param("warp_octaves", "int", 1, 1, 8,
+              doc="octaves of the turbulence (sines of rising frequency; phases fixed by the seed)"),
+        Param("warp_gain", "float", 0.5, 0.01, 1.0, doc="amplitude ratio of consecutive octaves", active=_octaves),
+        Param("warp_lacunarity", "float", 2.0, 1.0, 4.0, doc="frequency ratio of consecutive octaves", active=_octaves),
+        Param("warp_anisotropy", "vec3", [1.0, 1.0, 1.0], 0.0, 1.0,
+              doc="per-axis factors of the warp amplitude (the diagonal of A over warp_amplitude)"),
         Param("seed", "int", 1, 0, 2 ** 31 - 1, doc="the cloud's seed: same seed, same cloud"),
     )
 
     def evaluate(self, inputs, params, ctx):
+        params = {**self.default_params(), **params}     # a partial dict (a fit's): the schema's defaults
         density_field = _grid_field(inputs, "density", params)
         offset_field = _grid_field(inputs, "offset", params)
 
@@ -116,7 +170,9 @@ class ParticlesNode(NodeType):
                 density_span=(params["grade_from"], params["grade_to"]),
                 density_field=density_field, rule=_correlation_rule(params),
                 offset=params["offset"], offset_field=offset_field, warp_amplitude=params["warp_amplitude"],
-                warp_frequency=params["warp_frequency"], seed=params["seed"])
+                warp_frequency=params["warp_frequency"], warp_octaves=params["warp_octaves"],
+                warp_gain=params["warp_gain"], warp_lacunarity=params["warp_lacunarity"],
+                warp_amplitudes=_warp_amplitudes(params), seed=params["seed"])
         return {"sdf": built(make, params, {"density_field": "density", "offset_field": "offset",
                                             "cluster period": "cluster_period", "cluster size": "cluster_size",
                                             "size distribution parameter": "size_a", "cell width": "cell",
@@ -142,19 +198,19 @@ class PeriodicFunctionNode(NodeType):
         Param("cell", "float", 1.0, 1e-3, 1e4, unit="mm", doc="the period"),
         Param("level_by", "enum", "volume fraction", choices=("level", "volume fraction"),
               doc="set the level t directly or from a solid volume fraction"),
-        Param("level", "float", 0.0, -10.0, 10.0, doc="the level t (level_by = level)"),
+        Param("level", "float", 0.0, -10.0, 10.0, doc="the level t (level_by = level)", active=_by_level),
         Param("volume_fraction", "float", 0.3, 0.001, 0.999,
-              doc="the solid volume fraction of one cell (level_by = volume fraction)"),
+              doc="the solid volume fraction of one cell (level_by = volume fraction)", active=_by_fraction),
         Param("graded", "bool", False, doc="grade the level (and the cell) linearly along an axis"),
-        Param("level_end", "float", 0.5, -10.0, 10.0, doc="level at the end of the grading span (level_by = level)"),
+        Param("level_end", "float", 0.5, -10.0, 10.0, doc="level at the end of the grading span (level_by = level)", active=_graded_level),
         Param("volume_fraction_end", "float", 0.6, 0.001, 0.999,
               doc="volume fraction at the end of the grading span (level_by = volume fraction; the level "
-                  "in between is interpolated linearly)"),
+                  "in between is interpolated linearly)", active=_graded_fraction),
         Param("cell_end", "float", 0.0, 0.0, 1e4, unit="mm",
-              doc="cell at the end of the grading span; 0 keeps the cell (a graded cell needs the extent)"),
+              doc="cell at the end of the grading span; 0 keeps the cell (a graded cell needs the extent)", active=_graded),
         Param("grade_axis", "enum", "z", choices=AXES, doc="axis of the grading"),
-        Param("grade_from", "float", 0.0, -1e4, 1e4, unit="mm", doc="where the grading starts"),
-        Param("grade_to", "float", 10.0, -1e4, 1e4, unit="mm", doc="where the grading ends"),
+        Param("grade_from", "float", 0.0, -1e4, 1e4, unit="mm", doc="where the grading starts", active=_graded),
+        Param("grade_to", "float", 10.0, -1e4, 1e4, unit="mm", doc="where the grading ends", active=_graded),
         Param("extent", "vec3", [10.0, 10.0, 10.0], 1e-3, 1e4, unit="mm",
               doc="a graded cell's box [0, extent] (outside it the pattern is extruded)"),
     )

@@ -97,8 +97,9 @@ class NodeFit:
 
     type_name : the node's type; params : its current parameters (the start point and the
         values of everything not fitted); inputs : its evaluated inputs.
-    bounds : {parameter: (lo, hi)}; None fits every float parameter whose value is not 0,
-        within ``value * (1 -+ DEFAULT_SPREAD)`` clipped to its schema range.
+    bounds : {parameter: (lo, hi)}; None fits every float parameter whose value is not 0
+        and that takes effect (`Param.is_active`), within ``value * (1 -+ DEFAULT_SPREAD)``
+        clipped to its schema range.
 
     Raises
     ------
@@ -123,9 +124,10 @@ class NodeFit:
         floats = {p.name: p for p in self.cls.params if p.kind == "float"}
         if bounds is None:
             bounds = {}
+            current = {p.name: self.params.get(p.name, p.default) for p in self.cls.params}
             for name, p in floats.items():
-                v = float(self.params.get(name, p.default))
-                if v != 0:
+                v = float(current[name])
+                if v != 0 and p.is_active(current):
                     a, b = sorted((v * (1 - DEFAULT_SPREAD), v * (1 + DEFAULT_SPREAD)))
                     lo = a if p.minimum is None else max(a, p.minimum)
                     hi = b if p.maximum is None else min(b, p.maximum)

@@ -46,22 +46,36 @@ def test_the_cell_and_level_written_by_sdf_are_recovered_and_saved_to_a_copy(tmp
     assert fitted["cell"] == pytest.approx(info["params"]["cell"])
 
 
-def test_node_fit_defaults_to_the_nonzero_float_parameters_and_skips_refused_candidates():
+def test_node_fit_defaults_to_the_nonzero_active_float_parameters_and_skips_refused_candidates():
     fit = NodeFit("Particles", {"cell": 1.0, "distribution": "fixed", "size_a": 0.3, "size_b": 0.0,
                                 "shape": "sphere", "jitter": 0.0, "orient": False, "density": 1.0,
                                 "graded": False, "density_end": 0.0, "grade_axis": "z", "grade_from": 0.0,
                                 "grade_to": 10.0, "offset": 0.0, "warp_amplitude": 0.0,
                                 "warp_frequency": 0.0, "seed": 1})
-    assert fit.names == ("cell", "size_a", "density", "grade_to")
+    assert fit.names == ("cell", "size_a", "density")           # not grade_to: the ramp is off
     assert fit.bounds["size_a"] == pytest.approx((0.15, 0.45))
-    refused = fit._candidate([0.5, 0.45, 1.0, 10.0])             # size 0.45 in a 0.5 mm cell
+    refused = fit._candidate([0.5, 0.45, 1.0])                  # size 0.45 in a 0.5 mm cell
     assert np.all(np.isnan(refused.distance(np.zeros((3, 3)))))
     # a lattice of spheres recovered from its own samples by MSE
-    truth = fit.sdf([1.0, 0.3, 1.0, 10.0])
+    truth = fit.sdf([1.0, 0.3, 1.0])
     ex = Exemplar.from_sdf(truth, centre=(1.0, 1.0, 1.0), size=2.0, resolution=16)
     only = NodeFit("Particles", fit.params, bounds={"size_a": (0.1, 0.45)})
     result = only.fit(ex, algorithm="powell", max_evaluations=200, loss="mse")
     assert result.params[0] == pytest.approx(0.3, abs=1e-3)
+
+
+def test_a_default_fit_varies_only_what_takes_effect():
+    base = {"kind": "gyroid", "cell": 2.0, "level_by": "volume fraction", "volume_fraction": 0.3,
+            "graded": False}
+    assert NodeFit("PeriodicFunction", base).names == ("cell", "volume_fraction")
+    graded = NodeFit("PeriodicFunction", {**base, "graded": True, "grade_to": 4.0})
+    assert graded.names == ("cell", "volume_fraction", "volume_fraction_end", "grade_to")
+    by_level = NodeFit("PeriodicFunction", {**base, "level_by": "level", "level": 0.4})
+    assert by_level.names == ("cell", "level")
+    warped = {"cell": 1.0, "distribution": "fixed", "size_a": 0.3, "warp_amplitude": 0.05, "warp_frequency": 3.0}
+    assert NodeFit("Particles", warped).names == ("cell", "size_a", "jitter", "density", "warp_amplitude",
+                                                  "warp_frequency")
+    assert "warp_gain" in NodeFit("Particles", {**warped, "warp_octaves": 3}).names
 
 
 @pytest.mark.parametrize("text", ["cell", "cell=1", "cell=2:1", "=1:2", "cell=a:b"])

@@ -394,3 +394,136 @@ def test_bad_box_refused():
         sus.particles_in_box((1, 0, 0), (0, 1, 1))
     with pytest.raises(ValueError, match="at most"):
         sus.particles_in_box((0, 0, 0), (1000, 1000, 1000))
+
+
+# -- the turbulence warp (supplementary 10.1) ---------------------------------------------
+
+TURBULENT = dict(shape="ellipsoid", orient=True, size=SizeDistribution("uniform", 0.15, 0.3),
+                 warp_amplitude=0.12, warp_frequency=2.5, warp_octaves=3, warp_gain=0.6,
+                 warp_lacunarity=2.2, warp_matrix=((1.0, 0.3, 0.0), (0.0, 0.8, -0.4), (0.2, 0.0, 1.1)),
+                 warp_amplitudes=((0.12, 0.02, 0.0), (0.0, 0.05, 0.0), (0.03, 0.0, 0.1)))
+
+
+def _turbulent_frame(p, a, f, octaves, gain, lacunarity, m, seed):
+    """p + A T(p) written out from the formula (phases from the seed's phase table)."""
+    from engine.implicit.turbulence import phase_table
+    phases = phase_table(seed)
+    q = (p @ np.asarray(m).T)[:, [1, 2, 0]]
+    t = sum(gain ** o * np.sin(lacunarity ** o * f * q + phases[o]) for o in range(octaves))
+    return p + t @ np.asarray(a).T
+
+
+def test_turbulent_warp_moves_the_particle_frame():
+    sus = Suspension(cell=W, seed=6, **{**TURBULENT, "shape": "sphere", "orient": False})
+    p = _points(3000, seed=3)
+    x = _turbulent_frame(p, TURBULENT["warp_amplitudes"], 2.5, 3, 0.6, 2.2, TURBULENT["warp_matrix"], 6)
+    np.testing.assert_allclose(sus.warp(p), x, rtol=0, atol=1e-12)
+    ref = _brute_force(sus, x, exact_sphere=True)
+    f = sus.field(p)
+    assert np.all(f <= ref + 1e-12)
+    near = ref < 0.5 * W
+    assert near.mean() > 0.3
+    np.testing.assert_allclose(f[near], ref[near], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("kw", [
+    TURBULENT,
+    dict(warp_amplitude=0.1, warp_frequency=3.0, warp_octaves=5, warp_gain=0.7, warp_lacunarity=1.8,
+         size=SizeDistribution("normal", 0.3, 0.05)),
+])
+def test_turbulent_distance_is_a_lower_bound_of_the_world_distance(kw):
+    # the ball of radius |f(p)| / L about p lies wholly on p's side of the surface: no point q in
+    # it is inside a particle (brute force in the warped frame) when p is outside, and vice versa
+    sus = Suspension(cell=W, seed=11, **kw)
+    rng = np.random.default_rng(12)
+    p = _points(1500, seed=7)
+    d = sus.distance(p)
+    checked = 0
+    for _ in range(20):
+        u = rng.normal(size=p.shape)
+        u *= (rng.uniform(0, 1, (len(p), 1)) ** (1 / 3)) / np.linalg.norm(u, axis=1, keepdims=True)
+        q = p + np.abs(d)[:, None] * u * (1 - 1e-9)
+        inside = _brute_force(sus, sus.warp(q), exact_sphere=(sus.shape == "sphere")) - sus.offset < 0
+        assert not np.any(inside[d > 0]) and np.all(inside[d < 0])
+        checked += len(q)
+    assert checked == 30000 and (d < 0).sum() >= 20 and (d > 0).mean() > 0.3
+
+
+def test_turbulent_gradient_within_the_carried_bound():
+    sus = Suspension(cell=W, seed=9, **TURBULENT)
+    assert sus.lipschitz == pytest.approx(SHAPES["ellipsoid"].lipschitz * sus._warp.lipschitz)
+    rng = np.random.default_rng(4)
+    a = _points(20000, seed=8)
+    for step in (1e-5, 0.2):
+        b = a + rng.normal(0, step, a.shape)
+        ratio = np.abs(sus.field(a) - sus.field(b)) / np.linalg.norm(a - b, axis=1)
+        assert ratio.max() <= sus.lipschitz * (1 + 1e-6)
+
+
+def test_one_octave_fields_are_the_single_sine_warp():
+    old = dict(cell=W, seed=2, warp_amplitude=0.15, warp_frequency=3.0, size=SizeDistribution("uniform", 0.2, 0.4))
+    p = _points(2000)
+    same = Suspension(**old, warp_octaves=1, warp_gain=0.9, warp_lacunarity=3.0,
+                      warp_amplitudes=None, warp_matrix=None)
+    np.testing.assert_array_equal(same.field(p), Suspension(**old).field(p))
+    np.testing.assert_array_equal(Suspension(**old).warp(p), p + 0.15 * np.sin(3.0 * p[:, [1, 2, 0]]))
+    assert Suspension(**old).lipschitz == 1.0 + 0.15 * 3.0
+
+
+@pytest.mark.parametrize("kw", [
+    TURBULENT,
+    dict(warp_amplitude=0.1, warp_frequency=2.0, warp_octaves=4, warp_gain=0.5, warp_lacunarity=2.0,
+         shape="round_box", orient=True, density_field=DENSITY, offset_field=OFFSET),
+    dict(warp_amplitude=0.2, warp_frequency=1.5, warp_octaves=2, warp_amplitudes=np.diag([0.2, 0.0, 0.1]),
+         size=SizeDistribution("fixed", 0.4)),
+])
+def test_turbulent_glsl_matches_numpy(gpu, kw):
+    from engine.gpu.sdf_points import evaluate_glsl
+    sus = Suspension(cell=1.0, seed=21, **kw)
+    x = _points(6000, lo=-4.0, hi=4.0, seed=1)
+    np.testing.assert_allclose(evaluate_glsl(sus, x), sus.field(x), rtol=0, atol=1e-5)
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(warp_octaves=0), r"warp_octaves must be an int in \[1, 8\], got 0"),
+    (dict(warp_octaves=9), r"warp_octaves must be an int in \[1, 8\]"),
+    (dict(warp_octaves=2.5), "warp_octaves must be an int"),
+    (dict(warp_gain=0.0), r"warp_gain must be a finite number in \(0.0, 1.0\]"),
+    (dict(warp_gain=2.0), "warp_gain"),
+    (dict(warp_lacunarity=0.9), r"warp_lacunarity must be a finite number in \[1.0, 4.0\]"),
+    (dict(warp_lacunarity=math.nan), "warp_lacunarity"),
+    (dict(warp_matrix=np.eye(4)), "warp_matrix must be None or a 3 x 3 matrix of finite numbers"),
+    (dict(warp_matrix=np.full((3, 3), math.inf)), "warp_matrix"),
+    (dict(warp_amplitudes=[0.1, 0.2, 0.3]), "warp_amplitudes must be a number >= 0 .* or a 3 x 3 matrix"),
+    (dict(warp_amplitudes=np.full((3, 3), math.nan)), "warp_amplitudes"),
+])
+def test_bad_turbulence_refused(kw, match):
+    with pytest.raises(ValueError, match=match):
+        Suspension(**kw)
+
+
+def test_particles_node_passes_the_turbulence_on():
+    from engine.graph import AddNode, Evaluator, GraphDocument, SetParam, UndoStack
+    from engine.graph.node import node_type
+    doc = GraphDocument()
+    st = UndoStack(doc)
+    st.push(AddNode("Particles", {"cell": 1.0, "warp_amplitude": 0.2, "warp_frequency": 2.0, "warp_octaves": 3,
+                                  "warp_gain": 0.4, "warp_lacunarity": 2.5,
+                                  "warp_anisotropy": [1.0, 0.5, 0.0]}, node_id="p"))
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    sus = res.output("p")
+    assert (sus.warp_octaves, sus.warp_gain, sus.warp_lacunarity) == (3, 0.4, 2.5)
+    np.testing.assert_array_equal(sus.warp_amplitudes, np.diag([0.2, 0.1, 0.0]))
+    p = _points(500)
+    x = _turbulent_frame(p, np.diag([0.2, 0.1, 0.0]), 2.0, 3, 0.4, 2.5, np.eye(3), sus.seed)
+    np.testing.assert_allclose(sus.warp(p), x, rtol=0, atol=1e-12)
+    # defaults: the schema's, and the single-octave warp of before
+    cls = node_type("Particles")
+    assert [cls.param(n).default for n in ("warp_octaves", "warp_gain", "warp_lacunarity", "warp_anisotropy")] \
+        == [1, 0.5, 2.0, [1.0, 1.0, 1.0]]
+    st.push(SetParam("p", "warp_anisotropy", [1.0, 1.0, 1.0]))
+    st.push(SetParam("p", "warp_octaves", 1))
+    sus = Evaluator().evaluate(doc).output("p")
+    assert sus.warp_amplitudes is None
+    np.testing.assert_array_equal(sus.warp(p), p + 0.2 * np.sin(2.0 * p[:, [1, 2, 0]]))
