@@ -243,6 +243,7 @@ def _write_voxels(solid, sdf, plan, graph) -> dict:
     from engine.fileio import write_atomic
     from engine.geometry.mesh_io import export_mesh, mesh_summary
     from engine.nodes.implicit_solid import sdf_box
+    from engine.tiled_mesh import tiled_arrays
 
     out = plan["out"]
     params = graph.nodes["__sdf_solid"].params
@@ -259,8 +260,9 @@ def _write_voxels(solid, sdf, plan, graph) -> dict:
         write_atomic(plan["sidecar"], (json.dumps(side, indent=1) + "\n").encode())
         info["sidecar"] = str(plan["sidecar"].resolve())
     else:
-        export_mesh(solid.vertices + np.asarray(lo), solid.faces, str(out))
-        info.update(mesh_summary(solid.vertices, solid.faces))
+        vertices, faces = tiled_arrays(solid)                      # at the box's place
+        export_mesh(vertices, faces, str(out))
+        info.update(mesh_summary(vertices, faces))
     return info
 
 

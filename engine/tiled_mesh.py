@@ -55,9 +55,10 @@ def tiled_mesh_estimate(solid: Solid, tiles) -> int:
     return tiled_mesh_bytes(np.shape(solid.sdf), tiles, len(solid.faces))
 
 
-def tiled_arrays(solid: Solid, tiles=(1, 1, 1)) -> tuple[np.ndarray, np.ndarray]:
+def tiled_arrays(solid: Solid, tiles=(1, 1, 1), progress=None) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices, faces)`` of the solid tiled ``tiles`` cells per axis (copies
-    at multiples of the box, ``solid.box`` mm).
+    at multiples of the box, ``solid.box`` mm), placed at ``solid.origin``;
+    `progress` as `engine.geometry.marching.periodic_mesh` takes it.
 
     Raises ValueError for tiles outside [1, MAX_TILES] and MemoryLimitError
     (before allocating) when the tiled mesh would not fit the memory budget.
@@ -68,8 +69,13 @@ def tiled_arrays(solid: Solid, tiles=(1, 1, 1)) -> tuple[np.ndarray, np.ndarray]
     check_budget(tiled_mesh_estimate(solid, tiles), what=f"tiling {'x'.join(map(str, tiles))} cells",
                  lower="the tiles or the resolution", where="tiles")
     if tiles == (1, 1, 1):
-        return np.asarray(solid.vertices), np.asarray(solid.faces)
-    return periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size, cell=solid.cell)
+        v, f = np.asarray(solid.vertices), np.asarray(solid.faces)
+    else:
+        v, f = periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size, cell=solid.cell,
+                             progress=progress)
+    if any(solid.origin):
+        v = v + np.asarray(solid.origin)
+    return v, f
 
 
 def tiled_mesh(solid: Solid, tiles=(1, 1, 1)) -> MeshResult:

@@ -28,7 +28,7 @@ from PySide6 import QtCore, QtWidgets
 
 from engine.geometry.mesh_io import SUPPORTED_SUFFIXES
 from engine.memory import check_budget
-from engine.tiled_mesh import check_tiles, tiled_mesh_estimate
+from engine.tiled_mesh import check_tiles, tiled_arrays, tiled_mesh_estimate
 
 from .qt_wait import process_events_until
 from .task_runner import Task, TaskRunner
@@ -57,12 +57,7 @@ def check_export(solid, tiles, path: str | os.PathLike) -> tuple[tuple, Path]:
 def mesh_arrays(solid, tiles: tuple, progress=None) -> tuple[np.ndarray, np.ndarray]:
     """The arrays `engine.tiled_mesh.tiled_arrays` gives, with `progress(done, total)`
     between slabs of the marching cubes (returning False raises Cancelled)."""
-    if tiles == (1, 1, 1) or not solid.periodic:
-        return np.asarray(solid.vertices), np.asarray(solid.faces)
-    from engine.geometry.marching import periodic_mesh
-
-    return periodic_mesh(np.asarray(solid.sdf), tiles=tiles, cell_size=solid.cell_size, cell=solid.cell,
-                         progress=progress)
+    return tiled_arrays(solid, tiles if solid.periodic else (1, 1, 1), progress=progress)
 
 
 def write_mesh(task: Task, solid, tiles: tuple, path: Path) -> dict:

@@ -143,6 +143,10 @@ class Solid:
         sub-box of a part): it is shown and exported once, never tiled.
     cell : (Lx, Ly, Lz) box edges in cell units (default the unit cube); the
         tile measures ``cell_size * cell`` mm (:attr:`box`).
+    origin : (x, y, z) mm, where the box's low corner sits in the model: the
+        grid and the mesh are box-local (``[0, box]``, what the viewport shows
+        and tiling repeats); exports place the mesh at ``origin`` (a sub-box of
+        an implicit medium keeps its place; a unit cell has origin 0).
     """
 
     sdf: np.ndarray
@@ -151,6 +155,7 @@ class Solid:
     cell_size: float = 1.0
     periodic: bool = True
     cell: tuple = (1.0, 1.0, 1.0)
+    origin: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
         object.__setattr__(self, "sdf", frozen_array(self.sdf, np.float32))
@@ -160,6 +165,10 @@ class Solid:
         if len(cell) != 3 or not all(np.isfinite(v) and v > 0 for v in cell):
             raise ValueError(f"Solid: cell must be three box edges > 0; got {self.cell!r}")
         object.__setattr__(self, "cell", cell)
+        origin = tuple(float(v) for v in self.origin)
+        if len(origin) != 3 or not all(np.isfinite(v) for v in origin):
+            raise ValueError(f"Solid: origin must be three finite coordinates (mm); got {self.origin!r}")
+        object.__setattr__(self, "origin", origin)
 
     @property
     def resolution(self) -> int:

@@ -124,4 +124,5 @@ def solid_from_samples(samples: np.ndarray, lo, hi, periodic: bool, *, progress=
     else:
         verts, faces = box_mesh(s, spacing=edges / cells, progress=progress)
         kept = s[:-1, :-1, :-1]
-    return Solid(kept / size, verts, faces, size, periodic=bool(periodic), cell=tuple(edges / size))
+    return Solid(kept / size, verts, faces, size, periodic=bool(periodic), cell=tuple(edges / size),
+                 origin=tuple(a))

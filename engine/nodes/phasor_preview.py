@@ -78,4 +78,5 @@ class PhasorPreviewNode(NodeType):
         verts, faces = diamond_surface(volume, progress=stage(ctx.progress, SAMPLING_SHARE,
                                                               1.0 - SAMPLING_SHARE))
         extent = volume.hi - volume.lo
-        return {"solid": Solid(volume.indicator, verts - volume.lo, faces, float(extent.max()), periodic=False)}
+        return {"solid": Solid(volume.indicator, verts - volume.lo, faces, float(extent.max()), periodic=False,
+                                origin=tuple(volume.lo))}

@@ -222,3 +222,25 @@ def test_the_sdf_solid_memory_estimate_bounds_the_measured_peak(backend):
     assert res.ok, res.errors
     estimate = node_type("SDFSolid").memory_estimate(doc.nodes["solid"].params, {"sdf": res.output("p")})
     assert peak <= estimate <= 4 * peak
+
+
+def test_a_voxelised_sub_box_keeps_its_place_in_every_export():
+    """The Solid is box-local (what the viewport shows and tiles) but knows where its box sits:
+    the exported mesh of a sphere centred at (5, -3, 2) mm is centred there, within a voxel."""
+    from engine.tiled_mesh import tiled_arrays, tiled_mesh
+
+    doc, st = _graph()
+    st.push(AddNode("SDFShape", {"shape": "sphere", "extent": [2.0, 2.0, 2.0], "centre": [5.0, -3.0, 2.0]},
+                    node_id="s"))
+    _solid(st, "s", resolution=64)
+    res = Evaluator().evaluate(doc)
+    assert res.ok, res.errors
+    solid = res.output("solid")
+    spacing = float(solid.spacing.max())
+    local = np.asarray(solid.vertices)
+    assert np.all(local.min(axis=0) > -1e-9)                             # box-local, from 0
+    v, _ = tiled_arrays(solid)
+    np.testing.assert_allclose(v.min(axis=0), [4.0, -4.0, 1.0], atol=spacing)
+    np.testing.assert_allclose(v.max(axis=0), [6.0, -2.0, 3.0], atol=spacing)
+    bounds = np.array(tiled_mesh(solid).summary["bounds"])
+    np.testing.assert_allclose(bounds.mean(axis=0), [5.0, -3.0, 2.0], atol=spacing)
