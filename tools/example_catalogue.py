@@ -62,6 +62,8 @@ CATALOGUE: dict[str, tuple[str, str]] = {
     # implicit media (paper 004)
     "implicit_multiphase": (IMPLICIT, "Two particle clouds, spheres and turned rounded boxes, in one medium."),
     "implicit_ice_bubbles": (IMPLICIT, "A block of ice with air bubbles thinning out towards the top."),
+    "implicit_multiscale_ice": (IMPLICIT, "Ice whose bubbles grow from small and dense to large and sparse, "
+                                          "density painted in a Scalar Field."),
     "implicit_paper_fibres": (IMPLICIT, "A gyroid sheet pressed flat into interwoven paper-like fibres."),
     "implicit_rock_pile": (IMPLICIT, "Piled grains on a deformed lattice, convex at the bottom, dimpled on top."),
     "implicit_porous_lattice": (IMPLICIT, "Lattice spheres kept by a congruence rule: an open frame, homogenised."),

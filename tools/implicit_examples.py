@@ -1,7 +1,7 @@
 """The implicit media examples (paper 004): particle suspensions, ice with bubbles, gyroid
-fibres, a rock pile, an agglomerated porous lattice, a graded gyroid and a suspension blended
-with an octet cell.  Each ends in an SDF Solid node (what the viewport, the thumbnail and the
-exports show); the Implicit Media dock traces the SDF nodes themselves.  Written by
+fibres, a rock pile, an agglomerated porous lattice, a graded gyroid, a suspension blended
+with an octet cell and multiscale ice whose bubble density is painted.  Each ends in an SDF
+Solid node (what the viewport, the thumbnail and the exports show); the Implicit Media dock traces the SDF nodes themselves.  Written by
 tools/make_examples.py."""
 
 from __future__ import annotations
@@ -154,6 +154,42 @@ def implicit_suspension_octet() -> GraphDocument:
          ("blend", "sdf", "solid", "sdf")], base=base)
 
 
+def implicit_multiscale_ice() -> GraphDocument:
+    return _document(
+        "implicit_multiscale_ice", "Multiscale ice, density painted",
+        "Ice whose air bubbles change scale with height (paper 004, teaser and section 3.1): two "
+        "clouds on different grids, small bubbles on a 0.2 mm grid and large ones on a 0.75 mm grid, "
+        "each kept cell by cell with the probability its Scalar Field gives at the cell centre. The "
+        "small bubbles' field ramps from 1 at the bottom to 0 at the top, the large ones' the other way, "
+        "so the two scales hand over smoothly; a painted stroke clears a bubble-free band through the "
+        "small bubbles. Select a Scalar Field to paint it in the Implicit Media dock (each stroke is one "
+        "undo step). The SDF Solid shows the air (the block intersected with both clouds); the ice "
+        "itself, the block minus the clouds, is the node ice_with_air: select it to trace it.",
+        [("ice", "SDFShape", {"shape": "round_box", "extent": [3.0, 3.0, 3.0], "rounding": 0.2,
+                              "centre": [1.5, 1.5, 1.5]}),
+         ("small_density", "ScalarField", {
+             "lo": [0.0, 0.0, 0.0], "hi": [3.0, 3.0, 3.0], "resolution": 24, "mode": "ramp", "ramp_axis": "z",
+             "ramp_from": 0.0, "ramp_to": 3.0, "value_from": 1.0, "value_to": 0.0, "clamp": True,
+             "strokes": [{"axis": "y", "position": 1.5, "points": [[0.0, 0.6], [1.5, 1.2], [3.0, 0.9]],
+                          "radius": 0.25, "value": 0.0, "strength": 1.0, "falloff": "smooth", "depth": 30.0}]}),
+         ("large_density", "ScalarField", {
+             "lo": [0.0, 0.0, 0.0], "hi": [3.0, 3.0, 3.0], "resolution": 12, "mode": "ramp", "ramp_axis": "z",
+             "ramp_from": 0.5, "ramp_to": 3.0, "value_from": 0.0, "value_to": 0.7, "clamp": True}),
+         ("small", "Particles", {"cell": 0.2, "distribution": "uniform", "size_a": 0.03, "size_b": 0.07,
+                                 "seed": 4}),
+         ("large", "Particles", {"cell": 0.75, "distribution": "uniform", "size_a": 0.12, "size_b": 0.28,
+                                 "seed": 5}),
+         ("bubbles", "SDFBoolean", {"operation": "union"}),
+         ("air", "SDFBoolean", {"operation": "intersection"}),
+         ("ice_with_air", "SDFBoolean", {"operation": "difference"}),
+         ("solid", "SDFSolid", _solid(160))],
+        [("small_density", "field", "small", "density"), ("large_density", "field", "large", "density"),
+         ("small", "sdf", "bubbles", "a"), ("large", "sdf", "bubbles", "b"),
+         ("ice", "sdf", "air", "a"), ("bubbles", "sdf", "air", "b"),
+         ("ice", "sdf", "ice_with_air", "a"), ("bubbles", "sdf", "ice_with_air", "b"),
+         ("air", "sdf", "solid", "sdf")])
+
+
 IMPLICIT_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
     "implicit_multiphase": implicit_multiphase,
     "implicit_ice_bubbles": implicit_ice_bubbles,
@@ -162,6 +198,7 @@ IMPLICIT_EXAMPLES: dict[str, Callable[[], GraphDocument]] = {
     "implicit_porous_lattice": implicit_porous_lattice,
     "implicit_graded_gyroid": implicit_graded_gyroid,
     "implicit_suspension_octet": implicit_suspension_octet,
+    "implicit_multiscale_ice": implicit_multiscale_ice,
 }
 
 
