@@ -8,6 +8,7 @@ from engine.graph.errors import NodeInputError
 from engine.graph.node import NodeType, register
 from engine.graph.schema import Param, Port
 from engine.implicit.field_sampling import grid_field_from
+from engine.implicit.multiscale import MAX_LAYERS, multiscale_suspension
 from engine.implicit.particle_fields import clusters
 from engine.implicit.particles import SizeDistribution, Suspension
 from engine.implicit.periodic import KINDS, VARIANTS, Periodic
@@ -98,7 +99,11 @@ class ParticlesNode(NodeType):
     octaves (supp. 10.1: regions of different particle shape and anisotropy, blending
     smoothly; a multi-phase cloud).  A 2-D Field (over
     (u, v) = its x, y) is extruded along `field_axis`: u, v become x, y for z, x, z for y and
-    y, z for x.  Union two clouds for a multi-phase medium."""
+    y, z for x.  Union two clouds for a multi-phase medium.  With a `cell_width` Field the
+    cell width varies over space: `scales` clouds on geometric widths spanning the field's
+    range, each kept with a partition-of-unity weight of the local width
+    (`engine.implicit.multiscale`); `cell` is then the reference width of the size
+    distribution, whose sizes scale with each cloud's width."""
 
     type_name = "Particles"
     title = "Particles"
@@ -107,7 +112,10 @@ class ParticlesNode(NodeType):
     inputs = (Port("density", "Field", required=False,
                    doc="scalar field in [0, 1] multiplying the keep probability (read at cell centres)"),
               Port("offset", "Field", required=False,
-                   doc="scalar field (mm) added to the offset at each point; offset + its max < half a cell"))
+                   doc="scalar field (mm) added to the offset at each point; offset + its max < half a cell"),
+              Port("cell_width", "Field", required=False,
+                   doc="scalar field (mm, > 0): the local cell width; the cloud becomes a union of `scales` "
+                       "clouds on geometric widths over its range, blended by it (sizes relative to `cell`)"))
     outputs = (Port("sdf", "SDF"),)
     params = (
         Param("cell", "float", 1.0, 1e-3, 1e4, unit="mm", doc="grid cell width: one particle per cell at most"),
@@ -152,17 +160,20 @@ class ParticlesNode(NodeType):
         Param("warp_anisotropy", "vec3", [1.0, 1.0, 1.0], 0.0, 1.0,
               doc="per-axis factors of the warp amplitude (the diagonal of A over warp_amplitude)"),
         Param("seed", "int", 1, 0, 2 ** 31 - 1, doc="the cloud's seed: same seed, same cloud"),
+        Param("scales", "int", 3, 1, MAX_LAYERS,
+              doc="clouds blended when the cell_width Field is connected (cloud k has seed + k)"),
     )
 
     def evaluate(self, inputs, params, ctx):
         params = {**self.default_params(), **params}     # a partial dict (a fit's): the schema's defaults
         density_field = _grid_field(inputs, "density", params)
         offset_field = _grid_field(inputs, "offset", params)
+        width_field = _grid_field(inputs, "cell_width", params)
 
         def make():
             size = SizeDistribution(params["distribution"], params["size_a"],
                                     params["size_b"] if params["distribution"] != "fixed" else 0.0)
-            return Suspension(
+            kwargs = dict(
                 cell=params["cell"], shape=params["shape"], size=size, jitter=params["jitter"],
                 orient=params["orient"], density=params["density"],
                 density_end=params["density_end"] if params["graded"] else None,
@@ -173,7 +184,11 @@ class ParticlesNode(NodeType):
                 warp_frequency=params["warp_frequency"], warp_octaves=params["warp_octaves"],
                 warp_gain=params["warp_gain"], warp_lacunarity=params["warp_lacunarity"],
                 warp_amplitudes=_warp_amplitudes(params), seed=params["seed"])
-        return {"sdf": built(make, params, {"density_field": "density", "offset_field": "offset",
+            if width_field is None:
+                return Suspension(**kwargs)
+            return multiscale_suspension(kwargs, width_field, params["scales"])
+        return {"sdf": built(make, params, {"width_field": "cell_width", "layers": "scales",
+                                            "density_field": "density", "offset_field": "offset",
                                             "cluster period": "cluster_period", "cluster size": "cluster_size",
                                             "size distribution parameter": "size_a", "cell width": "cell",
                                             "density_span": "grade_to", "density_end": "density_end"})}

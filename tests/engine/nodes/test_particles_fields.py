@@ -146,3 +146,41 @@ def test_a_tiling_image_graph_drives_the_density():
     plain = Evaluator().evaluate(doc).output("q")
     assert plain.density_field is None and len(plain.particles_in_box(
         np.zeros(3), np.array([4.99, 2.99, 0.29])).cells) == len(cells)
+
+
+def test_a_cell_width_field_makes_a_union_of_scaled_clouds():
+    from engine.implicit.combine import Union
+    from engine.implicit.multiscale import layer_weights, layer_widths
+    img = Field(np.array([[0.25, 0.5, 1.0], [0.25, 0.5, 1.0]]), np.array([0.0, 0.0]), np.array([6.0, 4.0]))
+    sus = _evaluate({"cell_width": img}, field_axis="y", scales=3)      # (u, v) -> (x, z)
+    assert isinstance(sus, Union) and len(sus.parts) == 3
+    assert [p.cell for p in sus.parts] == pytest.approx([0.25, 0.5, 1.0])
+    assert [p.seed for p in sus.parts] == [3, 4, 5]
+    # sizes relative to cell = 0.5: fixed 0.2 mm becomes 0.1, 0.2 and 0.4 mm
+    assert [p.size.a for p in sus.parts] == pytest.approx([0.1, 0.2, 0.4])
+    # each cloud's weight is the hat of the width extruded along y (samples along x)
+    p = np.array([[1.0, 7.0, 1.0], [3.0, -2.0, 3.0], [5.0, 0.0, 2.0], [2.0, 1.0, 0.5]])
+    want = layer_weights(_bilinear(img.values, img.lo, img.hi, p[:, 0], p[:, 2]), layer_widths(0.25, 1.0, 3))
+    got = np.array([c.density_field.sample(p) for c in sus.parts])
+    np.testing.assert_allclose(got[:, :3], want[:, :3], atol=1e-12)         # at the samples: exact
+    np.testing.assert_allclose(got.sum(axis=0), 1.0, atol=1e-12)
+    # unconnected: today's single cloud
+    assert isinstance(_evaluate(scales=3), Suspension)
+
+
+@pytest.mark.parametrize("inputs, params, where, match", [
+    ({"cell_width": Field(np.array([[0.5, 0.0]]), np.zeros(2), np.ones(2))}, {}, "cell_width", "> 0"),
+    ({"cell_width": Field(np.array([[0.3, 2.0]]), np.zeros(2), np.ones(2))}, dict(offset=0.2), "offset",
+     r"layer 0 of 3 \(width 0.3 mm\)"),
+    ({"cell_width": Field(np.array([[0.3, 2.0]]), np.zeros(2), np.ones(2))},
+     dict(warp_octaves=3, warp_amplitude=0.1, warp_frequency=1.0), "warp_octaves", "warp_octaves must be 1"),
+])
+def test_bad_cell_width_inputs_are_refused_where_they_are(inputs, params, where, match):
+    with pytest.raises(NodeInputError, match=match) as info:
+        _evaluate(inputs, **params)
+    assert info.value.where == where
+
+
+def test_scales_is_refused_outside_its_schema_range():
+    with pytest.raises(ParamError, match="scales"):
+        ParticlesNode.validate_params({**BASE, "scales": 7})
