@@ -103,7 +103,8 @@ class Inspector(QtWidgets.QWidget):
         if node_id is not None and node_id not in self.doc.nodes:
             node_id = None
         self.node_id = node_id
-        self.param_form.show_node(None)
+        if node_id is None:
+            self.param_form.show_node(None)
         self.label_message.clear()
         has = node_id is not None
         for w in (self.ident_box, self.params_box, self.status_box):

@@ -46,14 +46,30 @@ class ParamForm(QtCore.QObject):
         self._refused: FieldMessage | None = None       # the latest refusal shown
         self._no_refusal = FieldMessage([])
         self._edits = MergingParamPush(undo)
+        self._shown: tuple = ()                          # the params the rows are for
 
     # -- rows -----------------------------------------------------------------------------------
     def show_node(self, node_id: str | None, params: Sequence[Param] = ()) -> None:
-        """Rows for `params` of `node_id` (none when None), showing the document's values."""
+        """Rows for `params` of `node_id` (none when None), showing the document's values.
+        The rows of the same parameters (another node of the same type) are kept and only
+        their values change: selecting along a row of like nodes rebuilds no widgets."""
+        params = tuple(params)
+        if node_id is not None and self.editors and params == self._shown:
+            self._edits.reset()
+            self.node_id = node_id
+            stored = self.doc.nodes[node_id].params
+            for name, editor in self.editors.items():
+                editor.set_value(stored.get(name, editor.param.default))
+            for message in self.messages.values():
+                message.clear()
+                self.form.setRowVisible(message, False)
+            self._refused = None
+            return
         self.clear()
         self.node_id = node_id
         if node_id is None:
             return
+        self._shown = params
         stored = self.doc.nodes[node_id].params
         parent = self.form.parentWidget()
         for param in params:
@@ -74,6 +90,7 @@ class ParamForm(QtCore.QObject):
         for editor in self.editors.values():
             editor.deleteLater()
         self.editors, self.messages, self._refused = {}, {}, None
+        self._shown: tuple = ()
         self._edits.reset()
 
     def set_row_visible(self, name: str, shown: bool) -> None:
