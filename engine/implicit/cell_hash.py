@@ -32,7 +32,7 @@ import numpy as np
 
 from .values import GlslModule
 
-__all__ = ["P1", "P2", "P3", "seed_word", "pcg_hash", "cell_key", "cell_stream", "cell_uniform",
+__all__ = ["P1", "P2", "P3", "check_seed", "seed_word", "pcg_hash", "cell_key", "cell_stream", "cell_uniform",
            "xorshift32", "xorshift_key", "GLSL_HASH", "add_glsl"]
 
 P1, P2, P3 = 73856093, 19349663, 83492791      # primes of the multilinear hash
@@ -55,6 +55,13 @@ def pcg_hash(v) -> np.ndarray:
         return (word >> _U(22)) ^ word
 
 
+def check_seed(seed) -> int:
+    """`seed` as a Python int; ValueError if it is not an integer (bools refused)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise ValueError(f"seed must be an int, got {seed!r}")
+    return int(seed)
+
+
 def seed_word(seed: int) -> int:
     """An integer seed (any size and sign) folded into a uint32 word (Python int).
 
@@ -63,9 +70,7 @@ def seed_word(seed: int) -> int:
     ValueError
         If `seed` is not an integer.
     """
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise ValueError(f"seed must be an int, got {seed!r}")
-    s = int(seed) % (1 << 64)
+    s = check_seed(seed) % (1 << 64)
     hi = pcg_hash(_U((s >> 32) ^ _GOLDEN))
     return int(pcg_hash(_U(s & _MASK) ^ hi))
 

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .cell_hash import check_seed
 from .values import GlslModule, as_points, glsl_float
 
 __all__ = ["Turbulence", "phase_table", "MAX_OCTAVES"]
@@ -67,9 +68,7 @@ def phase_table(seed: int) -> np.ndarray:
     ValueError
         If `seed` is not an integer.
     """
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise ValueError(f"seed must be an int, got {seed!r}")
-    rng = np.random.default_rng([_PHASE_STREAM, int(seed) % (1 << 64)])
+    rng = np.random.default_rng([_PHASE_STREAM, check_seed(seed) % (1 << 64)])
     table = np.zeros((MAX_OCTAVES, 3))
     table[1:] = rng.uniform(0.0, 2.0 * math.pi, (MAX_OCTAVES - 1, 3))
     return table

@@ -206,19 +206,14 @@ def test_sdf_shapes_have_their_closed_form_volumes_and_tight_boxes(shape, volume
 
 @pytest.mark.parametrize("backend", ["numpy", "auto"])
 def test_the_sdf_solid_memory_estimate_bounds_the_measured_peak(backend):
-    import tracemalloc
-
     from engine.graph import node_type
+
+    from .memory_peak import evaluate_traced
 
     doc, st = _graph()
     st.push(AddNode("Particles", {"cell": 0.1, "size_a": 0.02, "size_b": 0.04}, node_id="p"))
     _solid(st, "p", resolution=96, fit_box=False, box_from=[0, 0, 0], box_to=[1, 1, 1], backend=backend)
-    tracemalloc.start()
-    try:
-        res = Evaluator().evaluate(doc)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    res, peak = evaluate_traced(doc)
     assert res.ok, res.errors
     estimate = node_type("SDFSolid").memory_estimate(doc.nodes["solid"].params, {"sdf": res.output("p")})
     assert peak <= estimate <= 4 * peak

@@ -95,15 +95,10 @@ def test_a_bad_stroke_is_refused_at_the_strokes_parameter():
     ("ramp", [dict(STROKE, points=[[0.0, 0.0], [10.0, 8.0]], radius=7.0, falloff="smooth")]),  # all cells
 ])
 def test_the_memory_estimate_bounds_the_measured_peak(mode, strokes):
-    import tracemalloc
+    from .memory_peak import evaluate_traced
 
     doc, _ = _graph(lo=[0, 0, 0], hi=[10, 8, 6], resolution=64, mode=mode, strokes=strokes)
-    tracemalloc.start()
-    try:
-        res = Evaluator().evaluate(doc)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    res, peak = evaluate_traced(doc)
     assert res.ok, res.errors
     estimate = node_type("ScalarField").memory_estimate(doc.nodes["f"].params)
     assert res.output("f").values.size * 8 < peak <= estimate <= 4 * peak
